@@ -1,0 +1,130 @@
+"""Plant, disturbances and desired motion of paper 002, as compiled pure functions.
+
+The integrated state is ``y = [q (4), ω (3), q_d (4)]``: the spacecraft attitude and body rate
+of eq. (1) and the desired attitude of eq. (2), advanced together so that one fixed-step
+integration keeps them synchronous.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+
+from etsc_envs.core.jit import jit
+from etsc_envs.core.rotations import (
+    attitude_matrix,
+    cross,
+    error_quaternion,
+    quat_kinematics,
+    solve3,
+)
+
+SINUSOID, SQUARE = 0, 1
+
+PlantModel = namedtuple(
+    "PlantModel",
+    [
+        "nominal_inertia",  # J0, eq. (49)
+        "inertia_amplitude",  # ΔJ(t) = diag(a sin(w t + phase))
+        "inertia_frequency",
+        "inertia_phase",
+        "disturbance_amplitude",  # d(t) = a sin(w t + phase)
+        "disturbance_frequency",
+        "disturbance_phase",
+        "reference_kind",  # SINUSOID (eq. 53) or SQUARE (eqs. 54-55)
+        "reference_amplitude",  # per-axis amplitude (sinusoid) or level (square), rad/s
+        "reference_frequency",  # rad/s, sinusoid only
+        "reference_switch_period",  # T of eqs. (54)-(55), square only
+    ],
+)
+"""Everything the plant and the desired motion depend on, as arrays and scalars."""
+
+
+@jit
+def inertia(t: float, model: PlantModel) -> np.ndarray:
+    """True inertia J(t) = J0 + ΔJ(t) of section 4."""
+    variation = model.inertia_amplitude * np.sin(model.inertia_frequency * t + model.inertia_phase)
+    return model.nominal_inertia + np.diag(variation)
+
+
+@jit
+def disturbance(t: float, model: PlantModel) -> np.ndarray:
+    """External torque d(t) of section 4, N·m."""
+    return model.disturbance_amplitude * np.sin(
+        model.disturbance_frequency * t + model.disturbance_phase
+    )
+
+
+@jit
+def desired_rate(t: float, model: PlantModel) -> np.ndarray:
+    """ω_d(t): eq. (53) for the sinusoid, eqs. (54)-(55) for the square wave."""
+    if model.reference_kind == SINUSOID:
+        return model.reference_amplitude * np.sin(model.reference_frequency * t)
+    half_period_index = int(np.floor(t / model.reference_switch_period))
+    sign = 1.0 if half_period_index % 2 == 0 else -1.0
+    return sign * model.reference_amplitude
+
+
+@jit
+def desired_rate_derivative(t: float, model: PlantModel) -> np.ndarray:
+    """ω̇_d(t) (zero between the switches of the square wave)."""
+    if model.reference_kind == SINUSOID:
+        return (
+            model.reference_amplitude
+            * model.reference_frequency
+            * np.cos(model.reference_frequency * t)
+        )
+    return np.zeros(3)
+
+
+@jit
+def rate_derivative(
+    t: float, omega: np.ndarray, torque: np.ndarray, model: PlantModel
+) -> np.ndarray:
+    """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, with J = J(t)."""
+    inertia_now = inertia(t, model)
+    return solve3(inertia_now, -cross(omega, inertia_now @ omega) + torque + disturbance(t, model))
+
+
+@jit
+def plant_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
+    """ẏ for ``y = [q, ω, q_d]``: eq. (1) with the held torque ``args[0]``, and eq. (2)."""
+    torque, model = args
+    dy = np.empty(11)
+    dy[0:4] = quat_kinematics(y[0:4], y[4:7])
+    dy[4:7] = rate_derivative(t, y[4:7], torque, model)
+    dy[7:11] = quat_kinematics(y[7:11], desired_rate(t, model))
+    return dy
+
+
+@jit
+def tracking_error(t: float, y: np.ndarray, attitude_gain: np.ndarray, model: PlantModel):
+    """Error quaternion q_e and rate ω_e = ω - C ω_d of eq. (4), and z = ω_e + K q_ev (eq. 8).
+
+    Returns ``(q_e, omega_e, z, C)``.
+    """
+    q_e = error_quaternion(y[0:4], y[7:11])
+    dcm = attitude_matrix(q_e)
+    omega_e = y[4:7] - dcm @ desired_rate(t, model)
+    z = omega_e + attitude_gain * q_e[0:3]
+    return q_e, omega_e, z, dcm
+
+
+@jit
+def total_disturbance(
+    t: float, y: np.ndarray, torque: np.ndarray, attitude_gain: np.ndarray, model: PlantModel
+) -> np.ndarray:
+    """The extended state x_2 = F + G + d̄ of eq. (14), i.e. ż - J0⁻¹ u (eqs. 10 and 15).
+
+    Computed from the true plant: ż = ω̇ + ω_e^× C ω_d - C ω̇_d + ½ K (q_e4 I + q_ev^×) ω_e.
+    """
+    q_e, omega_e, _, dcm = tracking_error(t, y, attitude_gain, model)
+    omega_d = desired_rate(t, model)
+    z_dot = (
+        rate_derivative(t, y[4:7], torque, model)
+        + cross(omega_e, dcm @ omega_d)
+        - dcm @ desired_rate_derivative(t, model)
+        + attitude_gain * quat_kinematics(q_e, omega_e)[0:3]
+    )
+    return z_dot - solve3(model.nominal_inertia, torque)

@@ -1,0 +1,227 @@
+"""Rotation and rigid-motion algebra: quaternions, modified Rodrigues parameters, SO(3), SE(3).
+
+Conventions (used by every problem of the suite):
+
+* A quaternion is ``q = [q1, q2, q3, q4]`` with vector part ``q_v = q[:3]`` and scalar part
+  ``q4`` last, as in the attitude papers. The product is Hamilton's,
+  ``p ⊗ q = [p4 q_v + q4 p_v + p_v × q_v,  p4 q4 - p_v · q_v]``.
+* ``q`` gives the attitude of a body frame B relative to a reference frame R. The kinematics
+  with the body-frame angular velocity ω are ``q̇ = ½ q ⊗ [ω, 0]``, i.e.
+  ``q̇_v = ½ (q4 I + q_v^×) ω``, ``q̇4 = -½ q_vᵀ ω``.
+* ``attitude_matrix(q)`` is the direction-cosine matrix that maps R-frame components of a vector
+  to B-frame components, ``(1 - 2 q_vᵀq_v) I + 2 q_v q_vᵀ - 2 q4 q_v^×``. ``so3_exp`` returns the
+  rotation matrix ``R = attitude_matrix(q)ᵀ`` of the same rotation (B-frame components to R).
+* MRPs are ``σ = q_v / (1 + q4)``.
+
+All functions are compiled (see :mod:`etsc_envs.core.jit`) and take and return float64 arrays.
+"""
+
+import numpy as np
+
+from etsc_envs.core.jit import jit
+
+_SMALL_ANGLE = 1e-8
+
+
+@jit
+def skew(a: np.ndarray) -> np.ndarray:
+    """Cross-product matrix ``a^×`` such that ``a^× b = a × b``."""
+    out = np.zeros((3, 3))
+    out[0, 1] = -a[2]
+    out[0, 2] = a[1]
+    out[1, 0] = a[2]
+    out[1, 2] = -a[0]
+    out[2, 0] = -a[1]
+    out[2, 1] = a[0]
+    return out
+
+
+@jit
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Vector product ``a × b`` of two 3-vectors."""
+    out = np.empty(3)
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+    return out
+
+
+@jit
+def solve3(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve the 3×3 linear system ``matrix · x = rhs`` by Cramer's rule."""
+    a = matrix
+    c00 = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
+    c01 = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
+    c02 = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
+    det = a[0, 0] * c00 + a[0, 1] * c01 + a[0, 2] * c02
+    inv = np.empty((3, 3))
+    inv[0, 0] = c00
+    inv[1, 0] = c01
+    inv[2, 0] = c02
+    inv[0, 1] = a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]
+    inv[1, 1] = a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]
+    inv[2, 1] = a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]
+    inv[0, 2] = a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]
+    inv[1, 2] = a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]
+    inv[2, 2] = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
+    return inv @ rhs / det
+
+
+@jit
+def quat_multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Hamilton product ``p ⊗ q`` of scalar-last quaternions."""
+    out = np.empty(4)
+    out[:3] = p[3] * q[:3] + q[3] * p[:3] + cross(p[:3], q[:3])
+    out[3] = p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2]
+    return out
+
+
+@jit
+def quat_conjugate(q: np.ndarray) -> np.ndarray:
+    """Conjugate ``[-q_v, q4]``, the inverse of a unit quaternion."""
+    out = -q.copy()
+    out[3] = q[3]
+    return out
+
+
+@jit
+def quat_normalize(q: np.ndarray) -> np.ndarray:
+    """Unit quaternion along ``q``."""
+    return q / np.sqrt(q @ q)
+
+
+@jit
+def quat_kinematics(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Quaternion rate ``q̇ = ½ q ⊗ [ω, 0]`` for the body-frame rate ω (eq. (1)/(2) of 002)."""
+    out = np.empty(4)
+    out[:3] = 0.5 * (q[3] * omega + cross(q[:3], omega))
+    out[3] = -0.5 * (q[:3] @ omega)
+    return out
+
+
+@jit
+def error_quaternion(q: np.ndarray, q_desired: np.ndarray) -> np.ndarray:
+    """Attitude error ``q_e = q_d* ⊗ q`` (eq. (4) of 002): B relative to the desired frame."""
+    return quat_multiply(quat_conjugate(q_desired), q)
+
+
+@jit
+def attitude_matrix(q: np.ndarray) -> np.ndarray:
+    """DCM ``(1 - 2 q_vᵀq_v) I + 2 q_v q_vᵀ - 2 q4 q_v^×`` mapping R-frame to B-frame components."""
+    qv = q[:3]
+    return (1.0 - 2.0 * (qv @ qv)) * np.eye(3) + 2.0 * np.outer(qv, qv) - 2.0 * q[3] * skew(qv)
+
+
+@jit
+def quat_from_rotation_vector(phi: np.ndarray) -> np.ndarray:
+    """Unit quaternion of the rotation by angle ``‖φ‖`` about ``φ/‖φ‖``."""
+    angle = np.sqrt(phi @ phi)
+    out = np.empty(4)
+    if angle < _SMALL_ANGLE:
+        out[:3] = 0.5 * phi
+    else:
+        out[:3] = np.sin(0.5 * angle) / angle * phi
+    out[3] = np.cos(0.5 * angle)
+    return quat_normalize(out)
+
+
+@jit
+def so3_exp(phi: np.ndarray) -> np.ndarray:
+    """Rotation matrix ``exp(φ^×)`` (Rodrigues' formula)."""
+    angle = np.sqrt(phi @ phi)
+    phi_x = skew(phi)
+    if angle < _SMALL_ANGLE:
+        return np.eye(3) + phi_x + 0.5 * phi_x @ phi_x
+    return (
+        np.eye(3) + np.sin(angle) / angle * phi_x + (1.0 - np.cos(angle)) / angle**2 * phi_x @ phi_x
+    )
+
+
+@jit
+def so3_log(rotation: np.ndarray) -> np.ndarray:
+    """Rotation vector φ with ``so3_exp(φ) = rotation`` and ``‖φ‖ ≤ π``."""
+    cos_angle = min(1.0, max(-1.0, 0.5 * (np.trace(rotation) - 1.0)))
+    angle = np.arccos(cos_angle)
+    axis_sin = 0.5 * np.array(
+        [
+            rotation[2, 1] - rotation[1, 2],
+            rotation[0, 2] - rotation[2, 0],
+            rotation[1, 0] - rotation[0, 1],
+        ]
+    )
+    if angle < 1e-6:
+        return axis_sin
+    if np.pi - angle > 1e-6:
+        return angle / np.sin(angle) * axis_sin
+    # Near π: read the axis from the symmetric part R = 2 a aᵀ - I.
+    sym = 0.5 * (rotation + np.eye(3))
+    column = int(np.argmax(np.diag(sym)))
+    axis = sym[:, column] / np.sqrt(sym[column, column])
+    if axis @ axis_sin < 0.0:
+        axis = -axis
+    return angle * axis / np.sqrt(axis @ axis)
+
+
+@jit
+def so3_left_jacobian(phi: np.ndarray) -> np.ndarray:
+    """Left Jacobian of SO(3), the map from twist to translation in :func:`se3_exp`."""
+    angle = np.sqrt(phi @ phi)
+    phi_x = skew(phi)
+    if angle < _SMALL_ANGLE:
+        return np.eye(3) + 0.5 * phi_x + phi_x @ phi_x / 6.0
+    return (
+        np.eye(3)
+        + (1.0 - np.cos(angle)) / angle**2 * phi_x
+        + (angle - np.sin(angle)) / angle**3 * phi_x @ phi_x
+    )
+
+
+@jit
+def se3_exp(xi: np.ndarray) -> np.ndarray:
+    """Homogeneous 4×4 matrix ``exp(ξ^)`` of the twist ``ξ = [φ, χ]`` (rotation first)."""
+    g = np.eye(4)
+    g[:3, :3] = so3_exp(xi[:3])
+    g[:3, 3] = so3_left_jacobian(xi[:3]) @ xi[3:]
+    return g
+
+
+@jit
+def se3_log(g: np.ndarray) -> np.ndarray:
+    """Exponential coordinates ``ξ = [φ, χ]`` with ``se3_exp(ξ) = g``."""
+    phi = so3_log(g[:3, :3])
+    xi = np.empty(6)
+    xi[:3] = phi
+    xi[3:] = np.linalg.solve(so3_left_jacobian(phi), g[:3, 3].copy())
+    return xi
+
+
+@jit
+def se3_inverse(g: np.ndarray) -> np.ndarray:
+    """Inverse ``[Rᵀ, -Rᵀ p; 0, 1]`` of a homogeneous rigid motion."""
+    out = np.eye(4)
+    out[:3, :3] = g[:3, :3].T
+    out[:3, 3] = -g[:3, :3].T @ g[:3, 3]
+    return out
+
+
+@jit
+def quat_to_mrp(q: np.ndarray) -> np.ndarray:
+    """Modified Rodrigues parameters ``σ = q_v / (1 + q4)`` (the short rotation, ``‖σ‖ ≤ 1``)."""
+    sign = 1.0 if q[3] >= 0.0 else -1.0
+    return sign * q[:3] / (1.0 + sign * q[3])
+
+
+@jit
+def mrp_to_quat(sigma: np.ndarray) -> np.ndarray:
+    """Unit quaternion ``[2σ, 1 - σᵀσ] / (1 + σᵀσ)`` of an MRP vector."""
+    s2 = sigma @ sigma
+    out = np.empty(4)
+    out[:3] = 2.0 * sigma / (1.0 + s2)
+    out[3] = (1.0 - s2) / (1.0 + s2)
+    return out
+
+
+@jit
+def mrp_kinematics_matrix(sigma: np.ndarray) -> np.ndarray:
+    """``G(σ) = ½[(1 - σᵀσ)/2 I + σ^× + σσᵀ]`` so that ``σ̇ = G(σ) ω``."""
+    return 0.5 * (0.5 * (1.0 - sigma @ sigma) * np.eye(3) + skew(sigma) + np.outer(sigma, sigma))
