@@ -1,0 +1,204 @@
+"""Training configuration: the YAML keys, their validation and the algorithm names.
+
+A config is a YAML mapping with these keys (the optional ones show their default):
+
+* ``env_id`` — a registered Gymnasium id, e.g. ``etsc/AttitudeTracking-v0``;
+* ``env_kwargs: {}`` — passed to ``gym.make``; ``randomize`` defaults to ``true`` in training so
+  that the agent does not overfit one trajectory;
+* ``algorithm`` — one of :data:`ALGORITHMS` (``PPO``, ``A2C``, ``DQN``);
+* ``policy`` — an SB3 policy alias of that algorithm, e.g. ``MlpPolicy``;
+* ``hyperparameters: {}`` — keyword arguments of the algorithm's constructor;
+* ``total_timesteps`` — environment steps to train for, summed over the vectorised envs;
+* ``n_envs: 1`` — environments stepped together in one ``DummyVecEnv``;
+* ``seed: 0`` — seeds the algorithm and the environments (``null`` leaves them unseeded);
+* ``out_dir`` — where the model, the resolved config and the summary are written.
+
+Every problem raises a ``ValueError`` naming the key and what it allows.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import inspect
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import yaml
+from stable_baselines3 import A2C, DQN, PPO
+from stable_baselines3.common.base_class import BaseAlgorithm
+
+import etsc_envs
+
+ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"PPO": PPO, "A2C": A2C, "DQN": DQN}
+"""Algorithm name in a config → Stable-Baselines3 class."""
+
+TRAINING_ENV_DEFAULTS: dict[str, Any] = {"randomize": True}
+"""Env kwargs that training sets unless the config's ``env_kwargs`` says otherwise."""
+
+REQUIRED_KEYS = ("env_id", "algorithm", "policy", "total_timesteps", "out_dir")
+OPTIONAL_DEFAULTS: dict[str, Any] = {
+    "env_kwargs": {},
+    "hyperparameters": {},
+    "n_envs": 1,
+    "seed": 0,
+}
+
+CONFIG_SET_ARGUMENTS = ("policy", "env", "seed")
+"""Constructor arguments that come from the config's own keys, not from ``hyperparameters``."""
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainConfig:
+    """A validated training config; see the module docstring for the meaning of each field."""
+
+    env_id: str
+    env_kwargs: dict[str, Any]
+    algorithm: str
+    policy: str
+    hyperparameters: dict[str, Any]
+    total_timesteps: int
+    n_envs: int
+    seed: int | None
+    out_dir: str
+
+    @property
+    def algorithm_class(self) -> type[BaseAlgorithm]:
+        """The Stable-Baselines3 class named by :attr:`algorithm`."""
+        return ALGORITHMS[self.algorithm]
+
+    def as_dict(self) -> dict[str, Any]:
+        """The config as plain YAML-serialisable data, in the order of the fields."""
+        return dataclasses.asdict(self)
+
+
+def load_config(path: str | Path, overrides: Mapping[str, Any] | None = None) -> TrainConfig:
+    """Read a YAML config, replace the keys given in ``overrides`` and validate the result."""
+    with open(path, encoding="utf-8") as stream:
+        raw = yaml.safe_load(stream)
+    if not isinstance(raw, dict):
+        raise ValueError(f"{path}: a training config must be a YAML mapping of keys to values")
+    return config_from_dict({**raw, **(overrides or {})})
+
+
+def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
+    """Validate a config mapping and fill in the optional keys' defaults."""
+    _check_key_set(raw)
+    values = {**OPTIONAL_DEFAULTS, **raw}
+    algorithm = _check_algorithm(values["algorithm"])
+    return TrainConfig(
+        env_id=_check_env_id(values["env_id"]),
+        env_kwargs={**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])},
+        algorithm=algorithm,
+        policy=_check_policy(values["policy"], algorithm),
+        hyperparameters=_check_hyperparameters(values["hyperparameters"], algorithm),
+        total_timesteps=_check_positive_int("total_timesteps", values["total_timesteps"]),
+        n_envs=_check_positive_int("n_envs", values["n_envs"]),
+        seed=_check_seed(values["seed"]),
+        out_dir=_check_out_dir(values["out_dir"]),
+    )
+
+
+def _check_key_set(raw: Mapping[str, Any]) -> None:
+    allowed = (*REQUIRED_KEYS, *OPTIONAL_DEFAULTS)
+    unknown = sorted(str(key) for key in raw if key not in allowed)
+    if unknown:
+        raise ValueError(f"unknown config key(s) {unknown}; allowed keys: {list(allowed)}")
+    missing = [key for key in REQUIRED_KEYS if key not in raw]
+    if missing:
+        raise ValueError(f"missing config key(s) {missing}; required keys: {list(REQUIRED_KEYS)}")
+
+
+def _check_env_id(env_id: Any) -> str:
+    if not isinstance(env_id, str) or not env_id:
+        raise ValueError(f"config key 'env_id' must be a Gymnasium id string, got {env_id!r}")
+    module, _, bare_id = env_id.rpartition(":")
+    if module:
+        importlib.import_module(module)
+    if bare_id not in gym.registry:
+        raise ValueError(
+            f"config key 'env_id': {env_id!r} is not registered; "
+            f"etsc-envs registers {sorted(etsc_envs.ENV_IDS)}"
+        )
+    return env_id
+
+
+def _check_algorithm(name: Any) -> str:
+    if name not in ALGORITHMS:
+        raise ValueError(f"config key 'algorithm': {name!r} is not one of {list(ALGORITHMS)}")
+    return name
+
+
+def _check_policy(policy: Any, algorithm: str) -> str:
+    aliases = list(ALGORITHMS[algorithm].policy_aliases)
+    if policy not in aliases:
+        raise ValueError(
+            f"config key 'policy': {policy!r} is not a {algorithm} policy; allowed: {aliases}"
+        )
+    return policy
+
+
+def _check_mapping(key: str, value: Any) -> dict[str, Any]:
+    if not isinstance(value, dict) or not all(isinstance(name, str) for name in value):
+        raise ValueError(f"config key {key!r} must be a mapping of names to values, got {value!r}")
+    return dict(value)
+
+
+def _check_hyperparameters(value: Any, algorithm: str) -> dict[str, Any]:
+    hyperparameters = _check_mapping("hyperparameters", value)
+    allowed = _constructor_arguments(ALGORITHMS[algorithm])
+    unknown = sorted(set(hyperparameters) - set(allowed))
+    if unknown:
+        raise ValueError(
+            f"config key 'hyperparameters': {unknown} are not {algorithm} arguments; "
+            f"allowed: {allowed}"
+        )
+    for name, entry in hyperparameters.items():
+        _reject_numeric_string(f"hyperparameters.{name}", entry)
+    return hyperparameters
+
+
+def _constructor_arguments(algorithm_class: type[BaseAlgorithm]) -> list[str]:
+    """Keyword arguments of the algorithm's constructor that a config may set."""
+    parameters = inspect.signature(algorithm_class.__init__).parameters
+    return [
+        name
+        for name in parameters
+        if name != "self" and not name.startswith("_") and name not in CONFIG_SET_ARGUMENTS
+    ]
+
+
+def _reject_numeric_string(key: str, value: Any) -> None:
+    """PyYAML reads ``3e-4`` as a string (it needs ``3.0e-4``); catch that before SB3 does."""
+    if not isinstance(value, str):
+        return
+    try:
+        number = float(value)
+    except ValueError:
+        return
+    raise ValueError(
+        f"config key {key!r}: {value!r} was read as a string; write a YAML number such as "
+        f"{number!r} (PyYAML needs a dot and a signed exponent, e.g. 3.0e-4)"
+    )
+
+
+def _check_positive_int(key: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"config key {key!r} must be a positive integer, got {value!r}")
+    return value
+
+
+def _check_seed(value: Any) -> int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"config key 'seed' must be a non-negative integer or null, got {value!r}")
+    return value
+
+
+def _check_out_dir(value: Any) -> str:
+    if not isinstance(value, str | Path) or not str(value):
+        raise ValueError(f"config key 'out_dir' must be a directory path, got {value!r}")
+    return str(value)

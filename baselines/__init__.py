@@ -1,0 +1,1 @@
+"""Reference trigger policies (the papers', periodic, always) and the evaluation commands."""

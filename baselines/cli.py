@@ -1,0 +1,57 @@
+"""Pieces shared by the command-line tools: ``k=v`` arguments, policy specs, JSON output."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import yaml
+
+from baselines.episodes import to_jsonable
+from baselines.policies import AlwaysPolicy, PeriodicPolicy, load_sb3
+from baselines.triggers import PAPER_TRIGGERS
+
+POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
+
+
+def parse_assignments(pairs: list[str] | None, option: str) -> dict[str, Any]:
+    """``["k=v", ...]`` as a dict, each value read as YAML (numbers, booleans, lists, strings)."""
+    parsed: dict[str, Any] = {}
+    for pair in pairs or []:
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise ValueError(f"{option} takes key=value, got {pair!r}")
+        parsed[key] = yaml.safe_load(value)
+    return parsed
+
+
+def make_policy(spec: str, env: gym.Env, policy_args: dict[str, Any], env_id: str) -> Any:
+    """The policy named by ``spec`` (see :data:`POLICY_CHOICES`) for ``env``."""
+    observation_space, action_space = env.observation_space, env.action_space
+    if spec == "always":
+        return AlwaysPolicy(observation_space, action_space, **policy_args)
+    if spec == "periodic":
+        return PeriodicPolicy(observation_space, action_space, **policy_args)
+    if spec == "paper":
+        if env_id not in PAPER_TRIGGERS:
+            raise ValueError(f"no paper trigger for {env_id}; known: {sorted(PAPER_TRIGGERS)}")
+        names = env.unwrapped.observation_names
+        return PAPER_TRIGGERS[env_id](observation_space, action_space, names, **policy_args)
+    if spec.startswith("sb3:"):
+        if policy_args:
+            raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")
+        return load_sb3(spec.removeprefix("sb3:"))
+    raise ValueError(f"--policy must be one of {POLICY_CHOICES}, got {spec!r}")
+
+
+def write_json(payload: dict[str, Any], destination: str) -> None:
+    """Write ``payload`` as JSON to a file, or to standard output for ``-``."""
+    text = json.dumps(to_jsonable(payload), indent=2)
+    if destination == "-":
+        sys.stdout.write(text + "\n")
+    else:
+        Path(destination).parent.mkdir(parents=True, exist_ok=True)
+        Path(destination).write_text(text + "\n")

@@ -1,0 +1,119 @@
+"""Run trigger policies on environments and collect the design page's episode records."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from tqdm import tqdm
+
+import etsc_envs  # noqa: F401  (registers the environment ids)
+
+
+@dataclass
+class EpisodeTrace:
+    """Signals of one episode for plots: per-step time and cost, transmission instants, and
+    states sampled by the environment's ``state_dict``."""
+
+    time_s: list[float] = field(default_factory=list)
+    cost: list[float] = field(default_factory=list)
+    transmission_times_s: list[float] = field(default_factory=list)
+    samples: list[dict[str, np.ndarray]] = field(default_factory=list)
+
+    def sampled(self, name: str) -> np.ndarray:
+        """The sampled signal ``name`` as an array with time along the first axis."""
+        return np.array([sample[name] for sample in self.samples])
+
+
+def run_episode(
+    env: gym.Env,
+    policy: Any,
+    seed: int | None = None,
+    *,
+    sample_every: int | None = None,
+    progress: bool = False,
+    description: str = "",
+) -> tuple[dict[str, Any], EpisodeTrace]:
+    """Run one episode of ``policy`` (anything with an SB3-style ``predict``) on ``env``.
+
+    Args:
+        sample_every: if set, store ``env.unwrapped.state_dict()`` every that many steps.
+        progress: show a progress bar over the episode's sampling instants.
+
+    Returns the episode record (common keys of the design page plus the paper's metrics) and
+    the trace.
+    """
+    trace = EpisodeTrace()
+    unwrapped = env.unwrapped
+    sampler: Callable | None = getattr(unwrapped, "state_dict", None) if sample_every else None
+    obs, _ = env.reset(seed=seed)
+    state, episode_start = None, np.ones(1, dtype=bool)
+    total_return, steps = 0.0, 0
+    bar = tqdm(
+        total=getattr(unwrapped, "n_steps", None),
+        disable=not progress,
+        desc=description,
+        unit="step",
+        leave=False,
+        mininterval=0.5,
+    )
+    started = time.perf_counter()
+    if sampler is not None:
+        trace.samples.append(sampler())
+    while True:
+        action, state = policy.predict(
+            obs, state=state, episode_start=episode_start, deterministic=True
+        )
+        episode_start = np.zeros(1, dtype=bool)
+        time_before = unwrapped.time_s
+        obs, reward, terminated, truncated, info = env.step(action)
+        steps += 1
+        total_return += reward
+        trace.time_s.append(info["time_s"])
+        trace.cost.append(info["cost"])
+        if info["transmitted"]:
+            trace.transmission_times_s.append(time_before)
+        if sampler is not None and steps % sample_every == 0:
+            trace.samples.append(sampler())
+        if steps % 1000 == 0:
+            bar.update(1000)
+        if terminated or truncated:
+            break
+    bar.close()
+    record = {
+        "seed": seed,
+        "wall_time_s": time.perf_counter() - started,
+        "return": total_return,
+        **info["episode_metrics"],
+    }
+    return record, trace
+
+
+def mean_record(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """Mean of every numeric key over episodes (keys that are ``None`` somewhere are skipped),
+    plus ``failures``, the number of failed episodes."""
+    mean: dict[str, Any] = {}
+    for key, value in records[0].items():
+        values = [record.get(key) for record in records]
+        if key == "seed" or not all(isinstance(v, int | float) for v in values):
+            continue
+        mean[key] = float(np.mean(values))
+    mean["failures"] = sum(record.get("failure") is not None for record in records)
+    return mean
+
+
+def to_jsonable(value: Any) -> Any:
+    """``value`` with NumPy scalars and arrays turned into plain Python for ``json.dump``."""
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value

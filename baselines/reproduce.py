@@ -1,0 +1,51 @@
+"""Reproduce the papers' reported numbers and figures.
+
+    python -m baselines.reproduce [--paper NNN ...] [--json PATH|-] [--plot DIR]
+
+Prints, for every metric a paper reports, the paper's value beside the suite's, then checks the
+paper's qualitative claims. Without ``--paper`` every available reproduction runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from baselines.cli import write_json
+from baselines.reproductions import REPRODUCTIONS
+from baselines.reproductions.report import render
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m baselines.reproduce",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--paper",
+        action="append",
+        choices=sorted(REPRODUCTIONS),
+        help="paper number (repeatable); default: all available",
+    )
+    parser.add_argument("--json", metavar="PATH|-", help="write the comparison as JSON")
+    parser.add_argument("--plot", metavar="DIR", help="write the papers' figure counterparts")
+    args = parser.parse_args(argv)
+    papers = args.paper or sorted(REPRODUCTIONS)
+    results = []
+    for paper in papers:
+        module = REPRODUCTIONS[paper]
+        plot_dir = Path(args.plot) / f"paper_{paper}" if args.plot else None
+        result = module.reproduce(plot_dir=plot_dir, progress=sys.stderr.isatty())
+        results.append(result)
+        if args.json != "-":
+            print(render(result), flush=True)
+            print()
+    if args.json:
+        write_json({"reproductions": results}, args.json)
+    return 0 if all(item["holds"] for r in results for item in r.get("claims", [])) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

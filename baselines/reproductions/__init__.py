@@ -1,0 +1,10 @@
+"""Reproductions of the papers' reported numbers, one module per paper."""
+
+from __future__ import annotations
+
+from baselines.reproductions import attitude_tracking
+
+REPRODUCTIONS = {
+    "002": attitude_tracking,
+}
+"""Paper number → module with ``PAPER``, ``TITLE`` and ``reproduce(plot_dir, progress)``."""

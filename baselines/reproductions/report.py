@@ -1,0 +1,63 @@
+"""The shape of a reproduction result, and its text rendering (paper value beside ours)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One simulation of a paper: environment kwargs and trigger policy."""
+
+    label: str
+    env_args: tuple[tuple[str, Any], ...]
+    policy: str
+    policy_args: tuple[tuple[str, Any], ...] = ()
+
+
+def metric_row(scenario: Scenario, paper: dict[str, float], ours: dict[str, Any]) -> dict:
+    """A table row: every metric the paper reports, its value and ours, and the relative gap."""
+    metrics = {}
+    for name, paper_value in paper.items():
+        value = ours.get(name)
+        gap = None if value is None or paper_value == 0 else value / paper_value - 1.0
+        metrics[name] = {"paper": paper_value, "ours": value, "rel_diff": gap}
+    return {
+        "scenario": scenario.label,
+        "env_args": dict(scenario.env_args),
+        "policy": scenario.policy,
+        "policy_args": dict(scenario.policy_args),
+        "metrics": metrics,
+    }
+
+
+def claim(statement: str, holds: bool, detail: str) -> dict:
+    """A qualitative statement of the paper checked on our runs."""
+    return {"claim": statement, "holds": bool(holds), "detail": detail}
+
+
+def render(result: dict) -> str:
+    """Plain-text tables: for every row and metric, ``paper  ours  (gap %)``."""
+    lines = [f"Paper {result['paper']}: {result['title']}  [{result['env']}]"]
+    for table in result["tables"]:
+        lines += ["", table["name"]]
+        names = list(table["rows"][0]["metrics"])
+        header = f"  {'scenario':<34s}" + "".join(f"{n + ' paper/ours (gap)':>32s}" for n in names)
+        lines.append(header)
+        for row in table["rows"]:
+            cells = []
+            for name in names:
+                entry = row["metrics"][name]
+                gap = "" if entry["rel_diff"] is None else f" ({100 * entry['rel_diff']:+.1f}%)"
+                ours = "-" if entry["ours"] is None else f"{entry['ours']:.4g}"
+                cells.append(f"{entry['paper']:>10.4g} / {ours:<8s}{gap:>10s}")
+            lines.append(f"  {row['scenario']:<34s}" + "".join(f"{c:>32s}" for c in cells))
+    if result.get("claims"):
+        lines += ["", "Claims of the paper"]
+        for item in result["claims"]:
+            mark = "holds " if item["holds"] else "FAILS "
+            lines.append(f"  [{mark}] {item['claim']}: {item['detail']}")
+    if result.get("figures"):
+        lines += ["", "Figures: " + ", ".join(result["figures"])]
+    return "\n".join(lines)

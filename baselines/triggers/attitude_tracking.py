@@ -1,0 +1,42 @@
+"""The triggering condition eq. (27) of paper 002 as a trigger policy."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from baselines.policies import TriggerPolicy
+
+PAPER_PSI = 0.1
+"""Ψ of Tables 1-3's first event-triggered rows (the paper also runs 1.5 and 2.5)."""
+
+
+class AttitudeTrackingTrigger(TriggerPolicy):
+    """Γ(t) of eq. (27): transmit when Σ_i Σ_j |α_ji(e_1i, σ_i)| > Ψ ε_min.
+
+    The environment's ``trigger_statistic`` observation is that sum divided by ε_min, computed by
+    :func:`etsc_envs.attitude_tracking.controller.trigger_statistic` at the sensor.
+
+    Args:
+        psi: the event-triggering parameter Ψ (> 0).
+        observation_names: the environment's ``observation_names`` (to find the statistic).
+    """
+
+    def __init__(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        observation_names: tuple[str, ...],
+        psi: float = PAPER_PSI,
+    ) -> None:
+        super().__init__(observation_space, action_space)
+        psi = float(psi)
+        if not np.isfinite(psi) or psi <= 0.0:
+            raise ValueError(f"psi must be a finite number > 0, got {psi!r}")
+        self.psi = psi
+        self.statistic_index = observation_names.index("trigger_statistic")
+
+    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
+        return obs[:, self.statistic_index] > self.psi, state
