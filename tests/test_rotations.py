@@ -214,12 +214,6 @@ def test_so3_log_near_pi(gap):
         assert_allclose(so3_exp(recovered), rotation, rtol=0, atol=1e-6)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="so3_log reads the angle from arccos(trace) and divides by sin(angle): the error "
-    "grows like eps/(pi - angle)^2 (about 1e-3 rad just above the 1e-6 branch switch), where "
-    "an atan2-based angle would keep it near eps/(pi - angle)",
-)
 @pytest.mark.parametrize("gap", [1e-4, 1e-5, 2e-6])
 def test_so3_log_near_pi_is_accurate_to_conditioning(gap):
     """Best attainable accuracy near π is ~eps/gap (the axis read from a small sin(angle))."""
@@ -231,7 +225,7 @@ def test_so3_log_near_pi_is_accurate_to_conditioning(gap):
 def test_so3_log_at_pi_gives_the_same_rotation():
     """At exactly π the axis sign is ambiguous: compare the rotations, not the vectors.
 
-    The angle is read from ``arccos`` at -1, which is only sqrt(eps) accurate, hence 1e-7.
+    The angle comes from ``atan2(sin, cos)``; the axis from the symmetric part of R.
     """
     for axis in random_vectors(35, n=20):
         phi = np.pi * unit(axis)

@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """One simulation of a paper: environment kwargs and trigger policy."""
+    """One simulation of a paper: environment kwargs and trigger policy (the label is only
+    how a table names it, so the same run appearing in two tables is simulated once)."""
 
-    label: str
+    label: str = field(compare=False)
     env_args: tuple[tuple[str, Any], ...]
     policy: str
     policy_args: tuple[tuple[str, Any], ...] = ()

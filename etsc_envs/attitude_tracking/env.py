@@ -144,11 +144,13 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
         )
         desired = np.array(p.initial_desired_attitude) / np.linalg.norm(p.initial_desired_attitude)
         self.plant_state = np.concatenate([attitude, rate, desired])
-        self.observer_state = np.zeros(6)
         self.torque = np.zeros(3)
         self.measurement = tracking_error(
             0.0, self.plant_state, self.gains.attitude_gain, self.model
         )[2]
+        self.observer_state = np.zeros(6)
+        if p.observer_start == "first_measurement":
+            self.observer_state[0:3] = self.measurement
         self._features_now = sensor_features(
             self.measurement, self.observer_state, self.measurement, self.gains
         )

@@ -16,6 +16,7 @@ from etsc_envs.core.validation import (
 )
 
 REFERENCES = ("sinusoid", "square")
+OBSERVER_STARTS = ("first_measurement", "zero")
 
 
 @dataclass(frozen=True)
@@ -63,9 +64,12 @@ class AttitudeTrackingParams:
     """b of g_1(y) = b y + φ(y) (section 4.1: g_1(y) = 2y + φ(y))."""
     observer_c: float = 1.0
     """c of g_2(y) = c y (section 4.1: g_2(y) = y)."""
+    observer_start: str = "first_measurement"
+    """x̂(t_0) of eq. (16), not stated by the paper: 'first_measurement' starts x̂_1 at the
+    measurement x_1(t_0) sent at t_0 and x̂_2 at 0; 'zero' starts both at 0 (docs/fidelity.md)."""
     sampling_period_s: float = 0.001
     """t_s of section 4: observer and controller run by difference approximation at 1 ms."""
-    horizon_s: float = 60.0
+    horizon_s: float = 50.0
     """Simulation length T of eq. (50); not stated by the paper (see docs/fidelity.md)."""
     max_rate_rad_s: float = 10.0
     """Failure bound on ‖ω‖ and ‖ω_e‖: beyond it the episode terminates as diverged."""
@@ -87,6 +91,7 @@ class AttitudeTrackingParams:
         require_unit_quaternion("initial_attitude", self.initial_attitude)
         require_unit_quaternion("initial_desired_attitude", self.initial_desired_attitude)
         require_choice("reference", self.reference, REFERENCES)
+        require_choice("observer_start", self.observer_start, OBSERVER_STARTS)
         for name in (
             "observer_b",
             "observer_c",

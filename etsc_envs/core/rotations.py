@@ -139,9 +139,12 @@ def so3_exp(phi: np.ndarray) -> np.ndarray:
 
 @jit
 def so3_log(rotation: np.ndarray) -> np.ndarray:
-    """Rotation vector φ with ``so3_exp(φ) = rotation`` and ``‖φ‖ ≤ π``."""
+    """Rotation vector φ with ``so3_exp(φ) = rotation`` and ``‖φ‖ ≤ π``.
+
+    The angle is ``atan2(sin θ, cos θ)`` from the antisymmetric part and the trace, which stays
+    accurate near π where ``arccos`` of the trace does not.
+    """
     cos_angle = min(1.0, max(-1.0, 0.5 * (np.trace(rotation) - 1.0)))
-    angle = np.arccos(cos_angle)
     axis_sin = 0.5 * np.array(
         [
             rotation[2, 1] - rotation[1, 2],
@@ -149,14 +152,16 @@ def so3_log(rotation: np.ndarray) -> np.ndarray:
             rotation[1, 0] - rotation[0, 1],
         ]
     )
+    sin_angle = np.sqrt(axis_sin @ axis_sin)
+    angle = np.arctan2(sin_angle, cos_angle)
     if angle < 1e-6:
         return axis_sin
-    if np.pi - angle > 1e-6:
-        return angle / np.sin(angle) * axis_sin
-    # Near π: read the axis from the symmetric part R = 2 a aᵀ - I.
-    sym = 0.5 * (rotation + np.eye(3))
-    column = int(np.argmax(np.diag(sym)))
-    axis = sym[:, column] / np.sqrt(sym[column, column])
+    if sin_angle > 1e-3 or cos_angle > 0.0:
+        return angle / sin_angle * axis_sin
+    # Near π the axis comes from the symmetric part: (R + Rᵀ)/2 = cos θ I + (1 - cos θ) a aᵀ.
+    outer = (0.5 * (rotation + rotation.T) - cos_angle * np.eye(3)) / (1.0 - cos_angle)
+    column = int(np.argmax(np.diag(outer)))
+    axis = outer[:, column] / np.sqrt(outer[column, column])
     if axis @ axis_sin < 0.0:
         axis = -axis
     return angle * axis / np.sqrt(axis @ axis)
@@ -199,8 +204,9 @@ def se3_log(g: np.ndarray) -> np.ndarray:
 def se3_inverse(g: np.ndarray) -> np.ndarray:
     """Inverse ``[Rᵀ, -Rᵀ p; 0, 1]`` of a homogeneous rigid motion."""
     out = np.eye(4)
-    out[:3, :3] = g[:3, :3].T
-    out[:3, 3] = -g[:3, :3].T @ g[:3, 3]
+    rotation_t = np.ascontiguousarray(g[:3, :3].T)
+    out[:3, :3] = rotation_t
+    out[:3, 3] = -rotation_t @ np.ascontiguousarray(g[:3, 3])
     return out
 
 

@@ -1,0 +1,138 @@
+"""Constructor-argument checks of :mod:`etsc_envs.core.validation`.
+
+Checked properties: every ``require_*`` helper rejects physically meaningless input (negative,
+zero, NaN or infinite magnitudes, vectors of the wrong length, non-unit attitude quaternions,
+inertia-like matrices that are not symmetric positive definite, unknown options) with a
+``ValueError`` naming the offending argument, and returns the cleaned value otherwise
+(floats, float64 arrays, a renormalised quaternion).
+"""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from etsc_envs.core.validation import (
+    require_choice,
+    require_non_negative,
+    require_positive,
+    require_spd_matrix,
+    require_unit_quaternion,
+    require_vector,
+)
+
+BAD_NUMBERS = [np.nan, np.inf, -np.inf]
+
+
+@pytest.mark.parametrize("value", [0.0, -1.0, -1e-300, *BAD_NUMBERS])
+def test_require_positive_rejects(value):
+    with pytest.raises(ValueError, match="sample_time_s"):
+        require_positive("sample_time_s", value)
+
+
+@pytest.mark.parametrize("value", [1e-12, 0.1, 3, np.float32(2.5)])
+def test_require_positive_accepts(value):
+    result = require_positive("sample_time_s", value)
+    assert isinstance(result, float)
+    assert result == float(value)
+
+
+@pytest.mark.parametrize("value", [-1.0, -1e-300, *BAD_NUMBERS])
+def test_require_non_negative_rejects(value):
+    with pytest.raises(ValueError, match="threshold"):
+        require_non_negative("threshold", value)
+
+
+@pytest.mark.parametrize("value", [0.0, 0, 2.0])
+def test_require_non_negative_accepts(value):
+    result = require_non_negative("threshold", value)
+    assert isinstance(result, float)
+    assert result == float(value)
+
+
+def test_require_choice():
+    assert require_choice("trigger", "relative", ["fixed", "relative"]) == "relative"
+    assert require_choice("trigger", "fixed", (c for c in ("fixed", "relative"))) == "fixed"
+    with pytest.raises(ValueError, match="trigger") as info:
+        require_choice("trigger", "Relative", ["fixed", "relative"])
+    assert "fixed" in str(info.value)
+    assert "relative" in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "value",
+    [[1.0, 2.0], [1.0, 2.0, 3.0, 4.0], [[1.0, 2.0, 3.0]], [1.0, np.nan, 3.0], [np.inf, 0.0, 0.0]],
+)
+def test_require_vector_rejects(value):
+    with pytest.raises(ValueError, match="initial_rate"):
+        require_vector("initial_rate", value, 3)
+
+
+def test_require_vector_accepts_and_converts():
+    result = require_vector("initial_rate", [1, -2, 3], 3)
+    assert result.dtype == np.float64
+    assert_array_equal(result, [1.0, -2.0, 3.0])
+    assert_array_equal(require_vector("gains", (0.5, 2.0), 2, positive=True), [0.5, 2.0])
+
+
+@pytest.mark.parametrize("value", [[1.0, 0.0, 3.0], [1.0, -2.0, 3.0]])
+def test_require_vector_positive_rejects_non_positive_entries(value):
+    with pytest.raises(ValueError, match="gains"):
+        require_vector("gains", value, 3, positive=True)
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        [0.0, 0.0, 0.0, 1.1],
+        [0.0, 0.0, 0.0, 0.0],
+        [0.5, 0.5, 0.5, 0.4],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, 0.0, np.nan],
+    ],
+)
+def test_require_unit_quaternion_rejects(value):
+    with pytest.raises(ValueError, match="initial_attitude"):
+        require_unit_quaternion("initial_attitude", value)
+
+
+def test_require_unit_quaternion_normalises_nearly_unit_input():
+    direction = np.array([0.1, -0.3, 0.5, 0.8])
+    direction /= np.linalg.norm(direction)
+    result = require_unit_quaternion("initial_attitude", 1.00002 * direction)
+    assert_allclose(np.linalg.norm(result), 1.0, rtol=0, atol=1e-15)
+    assert_allclose(result, direction, rtol=0, atol=1e-15)
+
+
+def test_require_unit_quaternion_tolerance_is_configurable():
+    q = [0.0, 0.0, 0.0, 1.01]
+    assert_allclose(require_unit_quaternion("q", q, tolerance=0.02), [0.0, 0.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match="q"):
+        require_unit_quaternion("q", q)
+
+
+SPD = np.array([[10.0, 1.0, 0.5], [1.0, 12.0, -0.3], [0.5, -0.3, 8.0]])
+
+
+@pytest.mark.parametrize(
+    ("value", "reason"),
+    [
+        (np.eye(2), "3x3"),
+        (np.ones(3), "3x3"),
+        (np.where(np.eye(3) > 0, np.nan, 0.0), "finite"),
+        (SPD + np.triu(np.full((3, 3), 0.1), 1), "symmetric"),
+        (np.diag([1.0, 2.0, -3.0]), "positive definite"),
+        (np.diag([1.0, 0.0, 3.0]), "positive definite"),
+        (np.array([[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), "positive definite"),
+    ],
+    ids=["2x2", "vector", "nan", "non-symmetric", "negative", "singular", "indefinite"],
+)
+def test_require_spd_matrix_rejects(value, reason):
+    with pytest.raises(ValueError, match="inertia") as info:
+        require_spd_matrix("inertia", value)
+    assert reason in str(info.value)
+
+
+def test_require_spd_matrix_accepts():
+    result = require_spd_matrix("inertia", SPD.tolist())
+    assert result.dtype == np.float64
+    assert_array_equal(result, SPD)
