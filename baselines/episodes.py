@@ -97,7 +97,7 @@ def mean_record(records: list[dict[str, Any]]) -> dict[str, Any]:
     """Mean of every numeric key over episodes (keys that are ``None`` somewhere are skipped),
     plus ``failures``, the number of failed episodes."""
     mean: dict[str, Any] = {}
-    for key, value in records[0].items():
+    for key in records[0]:
         values = [record.get(key) for record in records]
         if key == "seed" or not all(isinstance(v, int | float) for v in values):
             continue

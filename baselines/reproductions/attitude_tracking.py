@@ -37,11 +37,9 @@ def _tt(reference: str, period_ms: int) -> Scenario:
     return _scenario(f"time-triggered {period_ms} ms", reference, "periodic", every=period_ms)
 
 
-def _et(reference: str, psi: float, uncertainties: bool = True) -> Scenario:
-    suffix = "" if uncertainties else ", no uncertainties"
-    return _scenario(
-        f"event-triggered Psi={psi}{suffix}", reference, "paper", uncertainties, psi=psi
-    )
+def _et(reference: str, psi: float, uncertainties: bool = True, label: str = "") -> Scenario:
+    label = label or f"event-triggered Psi={psi}"
+    return _scenario(label, reference, "paper", uncertainties, psi=psi)
 
 
 TABLE_1 = [  # sinusoidal ω_d, eq. (53)
@@ -57,10 +55,22 @@ TABLE_3 = [  # square-wave ω_d, eqs. (54)-(55)
     (_et("square", 2.5), {"T_A_ms": 401.52, "E_v": 0.0402, "E_q": 0.0092, "E_c": 1.16}),
 ]
 TABLE_2 = [  # ET-ADRC with Ψ = 0.1, with and without ΔJ and d
-    (_et("sinusoid", 0.1), {"mean_input_norm": 1.49, "E_v": 0.0122, "E_q": 0.0059}),
-    (_et("sinusoid", 0.1, False), {"mean_input_norm": 1.35, "E_v": 0.0123, "E_q": 0.0059}),
-    (_et("square", 0.1), {"mean_input_norm": 1.90, "E_v": 0.0158, "E_q": 0.0063}),
-    (_et("square", 0.1, False), {"mean_input_norm": 1.67, "E_v": 0.0157, "E_q": 0.0063}),
+    (
+        _et("sinusoid", 0.1, True, "sinusoid, with uncertainties"),
+        {"mean_input_norm": 1.49, "E_v": 0.0122, "E_q": 0.0059},
+    ),
+    (
+        _et("sinusoid", 0.1, False, "sinusoid, without uncertainties"),
+        {"mean_input_norm": 1.35, "E_v": 0.0123, "E_q": 0.0059},
+    ),
+    (
+        _et("square", 0.1, True, "square wave, with uncertainties"),
+        {"mean_input_norm": 1.90, "E_v": 0.0158, "E_q": 0.0063},
+    ),
+    (
+        _et("square", 0.1, False, "square wave, without uncertainties"),
+        {"mean_input_norm": 1.67, "E_v": 0.0157, "E_q": 0.0063},
+    ),
 ]
 TABLES = {
     "Table 1 - sinusoidal desired rate": TABLE_1,

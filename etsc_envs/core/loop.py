@@ -59,7 +59,8 @@ class EventTriggeredEnv(gym.Env):
         self.horizon_s = require_positive("horizon_s", horizon_s)
         if self.horizon_s < self.sampling_period_s:
             raise ValueError(
-                f"horizon_s must be >= sampling_period_s = {self.sampling_period_s}, got {horizon_s}"
+                f"horizon_s must be >= sampling_period_s ({self.sampling_period_s} s), "
+                f"got {horizon_s}"
             )
         self.transmission_penalty = require_non_negative(
             "transmission_penalty", transmission_penalty
