@@ -148,6 +148,12 @@ def _check_mapping(key: str, value: Any) -> dict[str, Any]:
 
 def _check_hyperparameters(value: Any, algorithm: str) -> dict[str, Any]:
     hyperparameters = _check_mapping("hyperparameters", value)
+    set_elsewhere = sorted(set(hyperparameters) & set(CONFIG_SET_ARGUMENTS))
+    if set_elsewhere:
+        raise ValueError(
+            f"config key 'hyperparameters': {set_elsewhere} come from the config's top-level "
+            f"keys ('policy', 'seed') and the env_id, not from hyperparameters"
+        )
     allowed = _constructor_arguments(ALGORITHMS[algorithm])
     unknown = sorted(set(hyperparameters) - set(allowed))
     if unknown:

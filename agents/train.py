@@ -11,6 +11,7 @@ steps per second and the last episodes' returns and metrics).
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.util
 import json
 import time
@@ -18,6 +19,7 @@ from collections import deque
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import yaml
 from stable_baselines3.common.base_class import BaseAlgorithm
@@ -68,7 +70,7 @@ def train(config: TrainConfig) -> Path:
     out_dir = Path(config.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     env = make_vec_env(
-        config.env_id,
+        functools.partial(gym.make, config.env_id),
         n_envs=config.n_envs,
         seed=config.seed,
         env_kwargs=config.env_kwargs,

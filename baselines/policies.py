@@ -102,13 +102,20 @@ class PeriodicPolicy(TriggerPolicy):
 
 
 def infer_sb3_algorithm(path: str | Path) -> type:
-    """The SB3 algorithm class that saved ``path``, read from the zip's ``policy_class``."""
+    """The SB3 algorithm class that saved ``path``, read from the zip's ``data`` record.
+
+    Off-policy algorithms save a policy of their own module (``stable_baselines3.dqn.policies``);
+    PPO and A2C share ``stable_baselines3.common.policies`` and differ by PPO's ``clip_range``.
+    """
     import stable_baselines3 as sb3
 
     with zipfile.ZipFile(path) as archive:
         data = json.loads(archive.read("data"))
-    module = data["policy_class"]["__module__"]  # e.g. "stable_baselines3.ppo.policies"
-    algorithm_name = module.split(".")[1].upper()
+    module = data["policy_class"]["__module__"]
+    if module == "stable_baselines3.common.policies":
+        algorithm_name = "PPO" if "clip_range" in data else "A2C"
+    else:
+        algorithm_name = module.split(".")[1].upper()
     algorithm = getattr(sb3, algorithm_name, None)
     if algorithm is None:
         raise ValueError(f"cannot tell the SB3 algorithm of {path} (policy module {module})")
