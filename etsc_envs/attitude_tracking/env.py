@@ -54,6 +54,8 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             ``reference="square"``, ``uncertainties=False``, ``horizon_s=30``) are applied on top.
         transmission_penalty: λ, reward lost per transmission.
         cost_scale: the per-step cost (integrands of E_v and E_q, eq. 50) is divided by this.
+            A diverging episode is charged a cost of ``max_rate_rad_s`` (the rate error at the
+            divergence bound) for every step it cuts from the horizon.
         randomize: draw the initial attitude (uniform axis, angle up to 60°), the initial rate
             (each axis uniform in ±0.05 rad/s) and the phases of ΔJ(t) and d(t) (uniform in
             [0, 2π)) at every reset instead of the paper's fixed values.
@@ -89,6 +91,7 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             horizon_s=self.params.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
+            failure_cost=self.params.max_rate_rad_s,
         )
         p = self.params
         self.gains = LoopGains(

@@ -3,7 +3,9 @@
 One call to :meth:`EventTriggeredEnv.step` is one sampling instant ``t_k`` of the design page:
 the agent's transmit bits refresh the held channel values from the current ones, then the
 problem advances plant, observer and controller over one sampling period with the held values,
-and the reward is ``-cost_k / cost_scale - transmission_penalty * (channels sent)``.
+and the reward is ``-cost_k / cost_scale - transmission_penalty * (channels sent)``. A failure
+(divergence, non-finite state) terminates the episode and charges ``failure_cost`` for each
+step left to the horizon.
 
 A problem subclasses :class:`EventTriggeredEnv` and provides five hooks: ``_reset_problem``
 (initial state from ``self.np_random``), ``_channel_values`` (what a transmission would send
@@ -38,6 +40,8 @@ class EventTriggeredEnv(gym.Env):
         horizon_s: the scenario's length (s); reaching it truncates the episode.
         transmission_penalty: λ, the reward lost per transmitted channel.
         cost_scale: divisor of the accuracy cost in the reward.
+        failure_cost: the cost charged for every step a failure cuts from the horizon, so that
+            ending an episode by diverging never pays more than staying in control.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
@@ -54,6 +58,7 @@ class EventTriggeredEnv(gym.Env):
         horizon_s: float,
         transmission_penalty: float,
         cost_scale: float,
+        failure_cost: float,
     ) -> None:
         self.sampling_period_s = require_positive("sampling_period_s", sampling_period_s)
         self.horizon_s = require_positive("horizon_s", horizon_s)
@@ -66,6 +71,7 @@ class EventTriggeredEnv(gym.Env):
             "transmission_penalty", transmission_penalty
         )
         self.cost_scale = require_positive("cost_scale", cost_scale)
+        self.failure_cost = require_non_negative("failure_cost", failure_cost)
         self.n_steps = round(self.horizon_s / self.sampling_period_s)
 
         self.channel = HeldChannel(n_channels, channel_width)
@@ -146,7 +152,10 @@ class EventTriggeredEnv(gym.Env):
             observation = self._observation()
         self.cost_sum += cost
         truncated = not terminated and self.step_index >= self.n_steps
-        reward = -cost / self.cost_scale - self.transmission_penalty * sent
+        charged = cost + (
+            self.failure_cost * (self.n_steps - self.step_index) if terminated else 0.0
+        )
+        reward = -charged / self.cost_scale - self.transmission_penalty * sent
         info: dict[str, Any] = {
             "transmitted": sent,
             "transmissions": int(self.channel.transmissions.sum()),
