@@ -69,7 +69,8 @@ def closed_loop_step(
 ):
     """Advance plant, desired motion and ET-ESO from t_k to t_k + h with the held ξ.
 
-    Returns ``(y_next, x_hat_next, u, z_next, features_next, rate_error, attitude_error,
+    Returns ``(y_next, x_hat_next, u, z_next, omega_e_next, features_next, rate_error,
+    attitude_error,
     energy_increment)`` where the errors are the eq. (50) integrands at t_k + h and the energy
     increment is the step's term of eq. (52).
     """
@@ -82,7 +83,7 @@ def closed_loop_step(
     y_next[0:4] /= np.sqrt(y_next[0:4] @ y_next[0:4])
     y_next[7:11] /= np.sqrt(y_next[7:11] @ y_next[7:11])
     t_next = t + h
-    z_next = tracking_error(t_next, y_next, gains.attitude_gain, model)[2]
+    _, omega_e_next, z_next, _ = tracking_error(t_next, y_next, gains.attitude_gain, model)
     features = sensor_features(z_next, x_hat_next, xi, gains)
     rate_error, attitude_error = tracking_accuracy(t_next, y_next, model)
     energy_increment = np.abs(0.5 * y_next[4:7] ** 2 - 0.5 * y[4:7] ** 2).sum()
@@ -91,6 +92,7 @@ def closed_loop_step(
         x_hat_next,
         torque,
         z_next,
+        omega_e_next,
         features,
         rate_error,
         attitude_error,

@@ -147,7 +147,7 @@ class EventTriggeredEnv(gym.Env):
         terminated = self.failure is not None
         if terminated:
             cost = 0.0 if not np.isfinite(cost) else cost
-            observation = self._last_observation
+            observation = self._last_observation.copy()
         else:
             observation = self._observation()
         self.cost_sum += cost
@@ -177,6 +177,7 @@ class EventTriggeredEnv(gym.Env):
 
     # ----------------------------------------------------------------- internals
     def _observation(self) -> np.ndarray:
+        """The observation at the current instant (remembered, to answer a copy after a failure)."""
         observation = np.empty(len(self.observation_names), dtype=np.float32)
         observation[: self._n_features] = self._features()
         observation[self._n_features :] = self.channel.time_since_sent(self.time_s)
