@@ -22,7 +22,13 @@ class EpisodeTrace:
     time_s: list[float] = field(default_factory=list)
     cost: list[float] = field(default_factory=list)
     transmission_times_s: list[float] = field(default_factory=list)
+    transmission_actions: list[np.ndarray] = field(default_factory=list)
     samples: list[dict[str, np.ndarray]] = field(default_factory=list)
+
+    def channel_transmission_times(self, channel: int) -> np.ndarray:
+        """Transmission instants of one channel of a ``MultiBinary`` action."""
+        sent = np.array([bool(np.ravel(action)[channel]) for action in self.transmission_actions])
+        return np.asarray(self.transmission_times_s)[sent] if len(sent) else np.zeros(0)
 
     def sampled(self, name: str) -> np.ndarray:
         """The sampled signal ``name`` as an array with time along the first axis."""
@@ -77,6 +83,7 @@ def run_episode(
         trace.cost.append(info["cost"])
         if info["transmitted"]:
             trace.transmission_times_s.append(time_before)
+            trace.transmission_actions.append(np.asarray(action))
         if sampler is not None and steps % sample_every == 0:
             trace.samples.append(sampler())
         if steps % 1000 == 0:

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from baselines.reproductions import attitude_tracking
+from baselines.reproductions import attitude_tracking, inner_formation
 
 REPRODUCTIONS = {
     "002": attitude_tracking,
+    "004": inner_formation,
 }
 """Paper number → module with ``PAPER``, ``TITLE`` and ``reproduce(plot_dir, progress)``."""

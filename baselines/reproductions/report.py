@@ -17,12 +17,15 @@ class Scenario:
     policy_args: tuple[tuple[str, Any], ...] = ()
 
 
-def metric_row(scenario: Scenario, paper: dict[str, float], ours: dict[str, Any]) -> dict:
-    """A table row: every metric the paper reports, its value and ours, and the relative gap."""
+def metric_row(scenario: Scenario, paper: dict[str, float | None], ours: dict[str, Any]) -> dict:
+    """A table row: every metric the paper reports, its value and ours, and the relative gap.
+
+    A paper value of ``None`` marks a metric the paper shows only qualitatively.
+    """
     metrics = {}
     for name, paper_value in paper.items():
         value = ours.get(name)
-        gap = None if value is None or paper_value == 0 else value / paper_value - 1.0
+        gap = None if value is None or not paper_value else value / paper_value - 1.0
         metrics[name] = {"paper": paper_value, "ours": value, "rel_diff": gap}
     return {
         "scenario": scenario.label,
@@ -44,7 +47,10 @@ def render(result: dict) -> str:
     for table in result["tables"]:
         lines += ["", table["name"]]
         names = list(table["rows"][0]["metrics"])
-        header = f"  {'scenario':<34s}" + "".join(f"{n + ' paper/ours (gap)':>32s}" for n in names)
+        width = max(32, *(len(n) + 20 for n in names))
+        header = f"  {'scenario':<34s}" + "".join(
+            f"{n + ' paper/ours (gap)':>{width}s}" for n in names
+        )
         lines.append(header)
         for row in table["rows"]:
             cells = []
@@ -52,8 +58,9 @@ def render(result: dict) -> str:
                 entry = row["metrics"][name]
                 gap = "" if entry["rel_diff"] is None else f" ({100 * entry['rel_diff']:+.1f}%)"
                 ours = "-" if entry["ours"] is None else f"{entry['ours']:.4g}"
-                cells.append(f"{entry['paper']:>10.4g} / {ours:<8s}{gap:>10s}")
-            lines.append(f"  {row['scenario']:<34s}" + "".join(f"{c:>32s}" for c in cells))
+                paper = "-" if entry["paper"] is None else f"{entry['paper']:.4g}"
+                cells.append(f"{paper:>10s} / {ours:<8s}{gap:>10s}")
+            lines.append(f"  {row['scenario']:<34s}" + "".join(f"{c:>{width}s}" for c in cells))
     if result.get("claims"):
         lines += ["", "Claims of the paper"]
         for item in result["claims"]:

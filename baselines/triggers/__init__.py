@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from baselines.triggers.attitude_tracking import AttitudeTrackingTrigger
+from baselines.triggers.inner_formation import InnerFormationTrigger
 
 PAPER_TRIGGERS = {
     "etsc/AttitudeTracking-v0": AttitudeTrackingTrigger,
+    "etsc/InnerFormation-v0": InnerFormationTrigger,
 }
 """Environment id → the paper's trigger policy class."""
