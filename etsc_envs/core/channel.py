@@ -35,6 +35,8 @@ class HeldChannel:
 
     def send(self, mask: np.ndarray, values: np.ndarray, time_s: float) -> int:
         """Refresh the held value of every channel whose ``mask`` entry is set; return how many."""
+        if not mask.any():
+            return 0
         values = np.reshape(values, (self.n_channels, self.width))
         sent = 0
         for channel in np.flatnonzero(mask):
