@@ -17,14 +17,25 @@ from baselines.triggers import PAPER_TRIGGERS
 POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
 
 
+def parse_value(text: str) -> Any:
+    """A command-line value: an int or float if it reads as one (``3e-5`` included, which YAML
+    1.1 would keep as a string), else YAML (booleans, lists, strings)."""
+    for number in (int, float):
+        try:
+            return number(text)
+        except ValueError:
+            pass
+    return yaml.safe_load(text)
+
+
 def parse_assignments(pairs: list[str] | None, option: str) -> dict[str, Any]:
-    """``["k=v", ...]`` as a dict, each value read as YAML (numbers, booleans, lists, strings)."""
+    """``["k=v", ...]`` as a dict, each value read by :func:`parse_value`."""
     parsed: dict[str, Any] = {}
     for pair in pairs or []:
         key, sep, value = pair.partition("=")
         if not sep or not key:
             raise ValueError(f"{option} takes key=value, got {pair!r}")
-        parsed[key] = yaml.safe_load(value)
+        parsed[key] = parse_value(value)
     return parsed
 
 

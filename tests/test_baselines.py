@@ -265,9 +265,10 @@ def test_reproduce_rejects_unknown_paper(capsys):
 # --------------------------------------------------------------------------- cli pieces
 def test_parse_assignments_reads_yaml_values():
     parsed = parse_assignments(
-        ["a=1", "b=true", "c=square", "d=0.5", "e=[1, 2]", "f=x=y"], "--env-arg"
+        ["a=1", "b=true", "c=square", "d=0.5", "e=[1, 2]", "f=x=y", "g=3e-5"], "--env-arg"
     )
-    assert parsed == {"a": 1, "b": True, "c": "square", "d": 0.5, "e": [1, 2], "f": "x=y"}
+    expected = {"a": 1, "b": True, "c": "square", "d": 0.5, "e": [1, 2], "f": "x=y", "g": 3e-5}
+    assert parsed == expected
     assert parse_assignments(None, "--env-arg") == {}
 
 
