@@ -11,14 +11,23 @@ Checked properties (on ~50 seeded random quaternions / rotation vectors each):
   is the group inverse;
 * MRPs: ``q`` and ``-q`` share one MRP set with ``‖σ‖ ≤ 1``, the quaternion round trip holds up
   to sign, and ``σ̇ = G(σ) ω`` agrees with a finite difference along the quaternion kinematics;
+* the closed-form ``G(σ)⁻¹`` inverts ``G(σ)`` and ``Ġ(σ, σ̇)`` matches a central difference;
 * the quaternion kinematics preserve the norm and integrate a constant body rate exactly;
 * ``error_quaternion`` matches the explicit component formula of the attitude-tracking paper;
-* ``solve3``, ``skew`` and ``cross`` agree with NumPy.
+* ``solve3``, ``skew`` and ``cross`` agree with NumPy;
+* SE(3) operators: ``se3_exp`` is the matrix exponential and ``se3_log`` its inverse, whose Φ
+  agrees with SciPy's rotation vector; ``Ad`` is a homomorphism conjugating twists, ``ad`` is
+  the Lie bracket and the derivative of ``Ad``, ``ad*`` is its dual and conserves the rigid
+  body's energy; ``G = J_r⁻¹`` is the rate of exponential coordinates (finite differences at
+  large, small and tiny angles) and equals paper 000's A and T blocks; small-angle series meet
+  the closed forms.
 """
 
 import numpy as np
 import pytest
+import scipy.linalg
 from numpy.testing import assert_allclose
+from scipy.spatial.transform import Rotation
 
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
@@ -27,6 +36,8 @@ from etsc_envs.core.rotations import (
     cross,
     error_quaternion,
     mrp_kinematics_matrix,
+    mrp_kinematics_matrix_inverse,
+    mrp_kinematics_matrix_rate,
     mrp_to_quat,
     quat_conjugate,
     quat_from_rotation_vector,
@@ -34,12 +45,18 @@ from etsc_envs.core.rotations import (
     quat_multiply,
     quat_normalize,
     quat_to_mrp,
+    se3_ad,
+    se3_adjoint,
+    se3_coad,
     se3_exp,
     se3_inverse,
     se3_log,
+    se3_right_jacobian_inverse,
     skew,
     so3_exp,
+    so3_left_jacobian,
     so3_log,
+    so3_right_jacobian_inverse,
     solve3,
 )
 
@@ -364,3 +381,247 @@ def test_error_quaternion_is_body_relative_to_desired():
             attitude_matrix(q_e), attitude_matrix(q) @ attitude_matrix(q_d).T, rtol=0, atol=1e-14
         )
         assert_allclose(error_quaternion(q, q), IDENTITY_QUAT, rtol=0, atol=1e-15)
+
+
+# --------------------------------------------------------------------------- MRP Jacobian
+
+
+def test_mrp_kinematics_matrix_inverse_is_the_inverse():
+    """``G⁻¹(σ) G(σ) = I`` for MRPs inside and outside the unit sphere."""
+    rng = np.random.default_rng(80)
+    for sigma in rng.uniform(-1.5, 1.5, size=(N_SAMPLES, 3)):
+        product = mrp_kinematics_matrix_inverse(sigma) @ mrp_kinematics_matrix(sigma)
+        assert_allclose(product, np.eye(3), rtol=0, atol=1e-12)
+
+
+def test_mrp_kinematics_matrix_rate_matches_finite_difference():
+    """``Ġ`` along ``σ̇`` is the central difference of ``G(σ + t σ̇)`` at ``t = 0``."""
+    rng = np.random.default_rng(81)
+    h = 1e-6
+    for sigma, sigma_dot in zip(
+        rng.uniform(-1.0, 1.0, size=(N_SAMPLES, 3)), random_vectors(82), strict=True
+    ):
+        forward = mrp_kinematics_matrix(sigma + h * sigma_dot)
+        backward = mrp_kinematics_matrix(sigma - h * sigma_dot)
+        assert_allclose(
+            mrp_kinematics_matrix_rate(sigma, sigma_dot), (forward - backward) / (2 * h), atol=1e-8
+        )
+
+
+# --------------------------------------------------------------------------- SE(3) operators
+# Ordering [rotation, translation]: V = [ω, v], g = [[R, r], [0, 1]] (orbit-attitude papers).
+
+
+def random_poses(seed: int, n: int = N_SAMPLES, scale: float = 10.0) -> list[np.ndarray]:
+    """Homogeneous rigid motions with uniformly random rotations and Gaussian translations."""
+    rng = np.random.default_rng(seed)
+    poses = []
+    for phi, r in zip(
+        random_rotation_vectors(seed + 1000, n), rng.normal(size=(n, 3)), strict=True
+    ):
+        g = np.eye(4)
+        g[:3, :3] = so3_exp(phi)
+        g[:3, 3] = scale * r
+        poses.append(g)
+    return poses
+
+
+def random_velocities(seed: int, n: int = N_SAMPLES) -> np.ndarray:
+    """Gaussian twists [ω, v] (the existing ``random_twists`` draws exponential coordinates)."""
+    return np.random.default_rng(seed).normal(size=(n, 6))
+
+
+def hat6(twist: np.ndarray) -> np.ndarray:
+    """The 4×4 matrix ``V^ = [[ω^×, v], [0, 0]]`` of se(3)."""
+    out = np.zeros((4, 4))
+    out[:3, :3] = skew(twist[:3])
+    out[:3, 3] = twist[3:]
+    return out
+
+
+def test_se3_exp_matches_matrix_exponential_and_log_round_trips():
+    """``se3_exp`` is ``expm`` of the 4×4 twist matrix; ``se3_log`` inverts it (‖φ‖ < π)."""
+    for phi, chi in zip(random_rotation_vectors(90), random_vectors(91, scale=30.0), strict=True):
+        xi = np.concatenate([phi, chi])
+        assert_allclose(se3_exp(xi), scipy.linalg.expm(hat6(xi)), rtol=0, atol=1e-11)
+        assert_allclose(se3_log(se3_exp(xi)), xi, rtol=0, atol=1e-8)
+
+
+def test_se3_log_rotation_part_matches_an_independent_rotation_vector():
+    """Φ of ``se3_log`` equals SciPy's rotation vector of the pose's rotation matrix, and χ
+    solves ``r = J_l(Φ) χ`` (eq. 6 of paper 000) with J_l written out independently."""
+    for g in random_poses(92):
+        xi = se3_log(g)
+        reference = Rotation.from_matrix(g[:3, :3]).as_rotvec()
+        assert_allclose(xi[:3], reference, rtol=0, atol=1e-10)
+        theta = np.linalg.norm(reference)
+        k = skew(reference)
+        s_matrix = (
+            np.eye(3)
+            + (1 - np.cos(theta)) / theta**2 * k
+            + (theta - np.sin(theta)) / theta**3 * k @ k
+        )
+        assert_allclose(s_matrix @ xi[3:], g[:3, 3], rtol=0, atol=1e-9)
+
+
+def test_so3_small_angle_jacobian_and_exp_have_no_cancellation():
+    """At θ = 1e-6 the left Jacobian and exp agree with their series to machine precision
+    (the closed forms (1 - cos θ)/θ² and (θ - sin θ)/θ³ lose ~1e-4 there)."""
+    for phi in random_rotation_vectors(93, max_angle=1e-6):
+        k = skew(phi)
+        theta = np.linalg.norm(phi)
+        series_jacobian = np.eye(3) + (0.5 - theta**2 / 24) * k + (1 / 6 - theta**2 / 120) * k @ k
+        assert_allclose(so3_left_jacobian(phi), series_jacobian, rtol=0, atol=1e-17)
+        series_exp = np.eye(3) + (1 - theta**2 / 6) * k + (0.5 - theta**2 / 24) * k @ k
+        assert_allclose(so3_exp(phi), series_exp, rtol=0, atol=1e-17)
+
+
+def test_adjoint_is_a_homomorphism_and_conjugates_twists():
+    """``Ad_{g1 g2} = Ad_{g1} Ad_{g2}``, ``Ad_{g⁻¹} = Ad_g⁻¹``, ``(Ad_g V)^ = g V^ g⁻¹``."""
+    poses_a, poses_b = random_poses(94), random_poses(95)
+    for g1, g2, twist in zip(poses_a, poses_b, random_velocities(96), strict=True):
+        assert_allclose(se3_adjoint(g1 @ g2), se3_adjoint(g1) @ se3_adjoint(g2), atol=1e-11)
+        assert_allclose(se3_adjoint(se3_inverse(g1)) @ se3_adjoint(g1), np.eye(6), atol=1e-12)
+        assert_allclose(
+            hat6(se3_adjoint(g1) @ twist), g1 @ hat6(twist) @ se3_inverse(g1), atol=1e-11
+        )
+
+
+def test_ad_is_the_lie_bracket_and_the_derivative_of_adjoint():
+    """``(ad_V W)^ = [V^, W^]``, antisymmetry, Jacobi, ``ad_V = d/dt Ad_{exp(tV)}|₀``, and the
+    paper's component form ``ad_(ω,v)(η,ψ) = (ω×η, ω×ψ - η×v)``."""
+    twists_a, twists_b, twists_c = (
+        random_velocities(97),
+        random_velocities(98),
+        random_velocities(99),
+    )
+    h = 1e-6
+    for a, b, c in zip(twists_a, twists_b, twists_c, strict=True):
+        bracket = hat6(a) @ hat6(b) - hat6(b) @ hat6(a)
+        assert_allclose(hat6(se3_ad(a) @ b), bracket, atol=1e-13)
+        assert_allclose(se3_ad(a) @ b, -se3_ad(b) @ a, atol=1e-13)
+        jacobi = se3_ad(a) @ se3_ad(b) @ c + se3_ad(b) @ se3_ad(c) @ a + se3_ad(c) @ se3_ad(a) @ b
+        assert_allclose(jacobi, np.zeros(6), atol=1e-12)
+        derivative = (se3_adjoint(se3_exp(h * a)) - se3_adjoint(se3_exp(-h * a))) / (2 * h)
+        assert_allclose(derivative, se3_ad(a), atol=1e-8)
+        omega, v, eta, psi = a[:3], a[3:], b[:3], b[3:]
+        assert_allclose(
+            se3_ad(a) @ b,
+            np.concatenate([np.cross(omega, eta), np.cross(omega, psi) - np.cross(eta, v)]),
+            atol=1e-13,
+        )
+
+
+def test_coadjoint_is_the_dual_of_ad_and_conserves_rigid_body_energy():
+    """``⟨ad*_V P, W⟩ = ⟨P, ad_V W⟩``; the paper's form ``ad*_(ω,v)(η,ψ) = (η×ω + ψ×v, ψ×ω)``;
+    and the free rigid body ``Ξ V̇ = ad*_V Ξ V`` conserves ``½ Vᵀ Ξ V``."""
+    inertia = np.diag([20.0, 21.0, 20.5]) + 0.5
+    xi = np.zeros((6, 6))
+    xi[:3, :3] = inertia
+    xi[3:, 3:] = 100.0 * np.eye(3)
+    for v_twist, w_twist, p in zip(
+        random_velocities(100), random_velocities(101), random_velocities(102), strict=True
+    ):
+        assert_allclose(
+            (se3_coad(v_twist) @ p) @ w_twist, p @ (se3_ad(v_twist) @ w_twist), atol=1e-12
+        )
+        omega, v, eta, psi = v_twist[:3], v_twist[3:], p[:3], p[3:]
+        assert_allclose(
+            se3_coad(v_twist) @ p,
+            np.concatenate([np.cross(eta, omega) + np.cross(psi, v), np.cross(psi, omega)]),
+            atol=1e-13,
+        )
+        v_dot = np.linalg.solve(xi, se3_coad(v_twist) @ xi @ v_twist)
+        assert abs(v_twist @ xi @ v_dot) < 1e-11 * (v_twist @ xi @ v_twist)
+
+
+def test_right_jacobian_inverse_is_the_rate_of_exponential_coordinates():
+    """``d/dt log(g exp(t V)) = G(ξ) V`` (eq. 7 of paper 000) for large, small and tiny angles;
+    ``A(φ) = J_r⁻¹(φ)`` alone does the same for SO(3)."""
+    h = 1e-6
+    for max_angle, seed in ((0.95 * np.pi, 103), (0.1, 104), (1e-4, 105)):
+        for phi, chi, twist in zip(
+            random_rotation_vectors(seed, max_angle=max_angle),
+            random_vectors(seed + 10, scale=20.0),
+            random_velocities(seed + 20),
+            strict=True,
+        ):
+            xi = np.concatenate([phi, chi])
+            g = se3_exp(xi)
+            rate = (se3_log(g @ se3_exp(h * twist)) - se3_log(g @ se3_exp(-h * twist))) / (2 * h)
+            assert_allclose(se3_right_jacobian_inverse(xi) @ twist, rate, rtol=1e-6, atol=1e-7)
+            rotation = so3_exp(phi)
+            so3_rate = (
+                so3_log(rotation @ so3_exp(h * twist[:3]))
+                - so3_log(rotation @ so3_exp(-h * twist[:3]))
+            ) / (2 * h)
+            assert_allclose(so3_right_jacobian_inverse(phi) @ twist[:3], so3_rate, atol=1e-7)
+
+
+def paper_coupling_block(phi: np.ndarray, chi: np.ndarray) -> np.ndarray:
+    """T(Φ, χ) of G(η̃) exactly as paper 000 prints it below eq. (7)."""
+    theta = np.linalg.norm(phi)
+    s, c = np.sin(theta), np.cos(theta)
+    k = skew(phi)
+    a_matrix = np.eye(3) + 0.5 * k + (1 / theta**2 - (1 + c) / (2 * theta * s)) * k @ k
+    s_matrix = np.eye(3) + (1 - c) / theta**2 * k + (theta - s) / theta**3 * k @ k
+    s_chi = s_matrix @ chi
+    return (
+        0.5 * skew(s_chi) @ a_matrix
+        + (1 / theta**2 - (1 + c) / (2 * theta * s)) * (np.outer(phi, chi) + (phi @ chi) * a_matrix)
+        - (1 + c) * (theta - s) / (2 * theta * s**2) * np.outer(s_chi, phi)
+        + ((1 + c) * (theta + s) / (2 * theta**3 * s**2) - 2 / theta**4)
+        * (phi @ chi)
+        * np.outer(phi, phi)
+    )
+
+
+def test_right_jacobian_inverse_matches_the_papers_blocks():
+    """G(η̃) = [[A, 0], [T, A]] with A and T as paper 000 writes them (θ away from 0 and π)."""
+    for phi, chi in zip(
+        random_rotation_vectors(106, max_angle=0.9 * np.pi),
+        random_vectors(107, scale=30.0),
+        strict=True,
+    ):
+        if np.linalg.norm(phi) < 0.05:
+            continue
+        g_matrix = se3_right_jacobian_inverse(np.concatenate([phi, chi]))
+        assert_allclose(g_matrix[:3, 3:], np.zeros((3, 3)), atol=0)
+        assert_allclose(g_matrix[3:, 3:], g_matrix[:3, :3], atol=0)
+        assert_allclose(g_matrix[3:, :3], paper_coupling_block(phi, chi), rtol=1e-9, atol=1e-9)
+
+
+def test_right_jacobian_inverse_is_continuous_at_the_series_switch():
+    """The series branches (θ < 0.1) meet the closed forms without a jump."""
+    axis = unit(np.array([0.3, -0.5, 0.8]))
+    chi = np.array([3.0, -20.0, 7.0])
+    below = se3_right_jacobian_inverse(np.concatenate([(0.1 - 1e-9) * axis, chi]))
+    above = se3_right_jacobian_inverse(np.concatenate([(0.1 + 1e-9) * axis, chi]))
+    assert_allclose(below, above, rtol=0, atol=1e-8)
+
+
+def test_euler_321_quaternion_is_the_yaw_pitch_roll_rotation():
+    """``attitude_matrix(quat_from_euler321(φ, θ, ψ)) = R1(φ) R2(θ) R3(ψ)`` (passive), i.e. the
+    transpose of SciPy's intrinsic 'ZYX' rotation, and ``quat_to_euler321`` inverts it."""
+    from etsc_envs.core.rotations import quat_from_euler321, quat_to_euler321
+
+    rng = np.random.default_rng(108)
+    for _ in range(N_SAMPLES):
+        roll, yaw = rng.uniform(-np.pi, np.pi, size=2)
+        pitch = rng.uniform(-0.49 * np.pi, 0.49 * np.pi)
+        q = quat_from_euler321(roll, pitch, yaw)
+        assert_allclose(np.linalg.norm(q), 1.0, atol=1e-15)
+        expected = Rotation.from_euler("ZYX", [yaw, pitch, roll]).as_matrix().T
+        assert_allclose(attitude_matrix(q), expected, atol=1e-12)
+        assert_allclose(quat_to_euler321(q), [roll, pitch, yaw], atol=1e-9)
+        assert_allclose(quat_to_euler321(-q), [roll, pitch, yaw], atol=1e-9)
+
+
+def test_quaternion_angle_is_the_principal_rotation_angle():
+    from etsc_envs.core.rotations import quat_angle
+
+    for phi in random_rotation_vectors(109):
+        q = quat_from_rotation_vector(phi)
+        assert_allclose(quat_angle(q), np.linalg.norm(phi), atol=1e-12)
+        assert_allclose(quat_angle(-q), np.linalg.norm(phi), atol=1e-12)
+    assert quat_angle(np.array([0.0, 0.0, 0.0, 1.0])) == 0.0

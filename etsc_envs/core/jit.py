@@ -9,3 +9,7 @@ from numba import njit
 
 jit = njit(cache=True, nogil=True)
 """Decorator: compile a function in nopython mode, caching the machine code on disk."""
+
+parallel_jit = njit(cache=True, nogil=True, parallel=True)
+"""Decorator for batch precomputations: like :data:`jit`, and ``numba.prange`` loops run on all
+cores (``NUMBA_NUM_THREADS`` limits them)."""

@@ -11,7 +11,8 @@ A problem subclasses :class:`EventTriggeredEnv` and provides five hooks: ``_rese
 (initial state from ``self.np_random``), ``_channel_values`` (what a transmission would send
 now), ``_advance`` (one sampling period with ``self.channel.held``, returning the step's cost),
 ``_failure`` (``None`` or why the episode must stop), ``_features`` (the problem's part of the
-observation) and ``_paper_metrics`` (the paper's own episode metrics).
+observation) and ``_paper_metrics`` (the paper's own episode metrics); optionally
+``_accepts_transmission`` (which channels can take a transmission now, all by default).
 """
 
 from __future__ import annotations
@@ -114,6 +115,12 @@ class EventTriggeredEnv(gym.Env):
     def _paper_metrics(self) -> dict[str, Any]:
         raise NotImplementedError
 
+    def _accepts_transmission(self) -> np.ndarray:
+        """Which channels can take a transmission now (default: all). A problem whose receiver
+        is busy (a thrust burst already running) refuses one: the request changes nothing, is
+        not counted and is not charged."""
+        return np.ones(self.channel.n_channels, dtype=bool)
+
     # ----------------------------------------------------------------- Gymnasium API
     @property
     def time_s(self) -> float:
@@ -139,7 +146,7 @@ class EventTriggeredEnv(gym.Env):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self.failure is not None or self.step_index >= self.n_steps:
             raise RuntimeError("step() called after the episode ended; call reset() first")
-        mask = self._transmit_mask(action)
+        mask = self._transmit_mask(action) & self._accepts_transmission()
         sent = self.channel.send(mask, self._channel_values(), self.time_s)
         cost = self._advance()
         self.step_index += 1

@@ -126,15 +126,20 @@ def quat_from_rotation_vector(phi: np.ndarray) -> np.ndarray:
 
 
 @jit
+def _one_minus_cos_over_sq(angle: float) -> float:
+    """``(1 - cos θ)/θ²`` as ``½ (sin(θ/2)/(θ/2))²``, free of the cancellation at small θ."""
+    half_sinc = np.sin(0.5 * angle) / (0.5 * angle)
+    return 0.5 * half_sinc * half_sinc
+
+
+@jit
 def so3_exp(phi: np.ndarray) -> np.ndarray:
     """Rotation matrix ``exp(φ^×)`` (Rodrigues' formula)."""
     angle = np.sqrt(phi @ phi)
     phi_x = skew(phi)
     if angle < _SMALL_ANGLE:
         return np.eye(3) + phi_x + 0.5 * phi_x @ phi_x
-    return (
-        np.eye(3) + np.sin(angle) / angle * phi_x + (1.0 - np.cos(angle)) / angle**2 * phi_x @ phi_x
-    )
+    return np.eye(3) + np.sin(angle) / angle * phi_x + _one_minus_cos_over_sq(angle) * phi_x @ phi_x
 
 
 @jit
@@ -174,11 +179,12 @@ def so3_left_jacobian(phi: np.ndarray) -> np.ndarray:
     phi_x = skew(phi)
     if angle < _SMALL_ANGLE:
         return np.eye(3) + 0.5 * phi_x + phi_x @ phi_x / 6.0
-    return (
-        np.eye(3)
-        + (1.0 - np.cos(angle)) / angle**2 * phi_x
-        + (angle - np.sin(angle)) / angle**3 * phi_x @ phi_x
-    )
+    if angle < 0.1:  # (θ - sin θ)/θ³ by its series: the closed form cancels to ~1e-16/θ²
+        a2 = angle * angle
+        third = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0 - a2 * a2 * a2 / 362880.0
+    else:
+        third = (angle - np.sin(angle)) / angle**3
+    return np.eye(3) + _one_minus_cos_over_sq(angle) * phi_x + third * phi_x @ phi_x
 
 
 @jit
@@ -196,7 +202,7 @@ def se3_log(g: np.ndarray) -> np.ndarray:
     phi = so3_log(g[:3, :3])
     xi = np.empty(6)
     xi[:3] = phi
-    xi[3:] = np.linalg.solve(so3_left_jacobian(phi), g[:3, 3].copy())
+    xi[3:] = solve3(so3_left_jacobian(phi), np.ascontiguousarray(g[:3, 3]))
     return xi
 
 
@@ -229,5 +235,188 @@ def mrp_to_quat(sigma: np.ndarray) -> np.ndarray:
 
 @jit
 def mrp_kinematics_matrix(sigma: np.ndarray) -> np.ndarray:
-    """``G(σ) = ½[(1 - σᵀσ)/2 I + σ^× + σσᵀ]`` so that ``σ̇ = G(σ) ω``."""
-    return 0.5 * (0.5 * (1.0 - sigma @ sigma) * np.eye(3) + skew(sigma) + np.outer(sigma, sigma))
+    """``G(σ) = ½[(1 - σᵀσ)/2 I + σ^× + σσᵀ]`` so that ``σ̇ = G(σ) ω``.
+
+    Written entry by entry (it sits on the hot path of MRP-based problems).
+    """
+    x, y, z = sigma[0], sigma[1], sigma[2]
+    diagonal = 0.5 * (1.0 - (x * x + y * y + z * z))
+    out = np.empty((3, 3))
+    out[0, 0] = 0.5 * (diagonal + x * x)
+    out[0, 1] = 0.5 * (-z + x * y)
+    out[0, 2] = 0.5 * (y + x * z)
+    out[1, 0] = 0.5 * (z + y * x)
+    out[1, 1] = 0.5 * (diagonal + y * y)
+    out[1, 2] = 0.5 * (-x + y * z)
+    out[2, 0] = 0.5 * (-y + z * x)
+    out[2, 1] = 0.5 * (x + z * y)
+    out[2, 2] = 0.5 * (diagonal + z * z)
+    return out
+
+
+@jit
+def mrp_kinematics_matrix_inverse(sigma: np.ndarray) -> np.ndarray:
+    """``G(σ)⁻¹ = 16 G(σ)ᵀ / (1 + σᵀσ)²``, so that ``ω = G(σ)⁻¹ σ̇``.
+
+    ``4 G(σ)`` is ``(1 + σᵀσ)`` times a rotation matrix, hence the closed form; it exists for
+    every σ.
+    """
+    scale = 16.0 / (1.0 + sigma[0] ** 2 + sigma[1] ** 2 + sigma[2] ** 2) ** 2
+    return scale * np.ascontiguousarray(mrp_kinematics_matrix(sigma).T)
+
+
+@jit
+def mrp_kinematics_matrix_rate(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
+    """Time derivative ``Ġ = ½[-(σᵀσ̇) I + σ̇^× + σ̇σᵀ + σσ̇ᵀ]`` of ``G(σ)`` along ``σ̇``."""
+    projection = sigma[0] * sigma_dot[0] + sigma[1] * sigma_dot[1] + sigma[2] * sigma_dot[2]
+    out = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = 0.5 * (sigma_dot[i] * sigma[j] + sigma[i] * sigma_dot[j])
+        out[i, i] -= 0.5 * projection
+    out[0, 1] -= 0.5 * sigma_dot[2]
+    out[0, 2] += 0.5 * sigma_dot[1]
+    out[1, 0] += 0.5 * sigma_dot[2]
+    out[1, 2] -= 0.5 * sigma_dot[0]
+    out[2, 0] -= 0.5 * sigma_dot[1]
+    out[2, 1] += 0.5 * sigma_dot[0]
+    return out
+
+
+# --------------------------------------------------------------------------- SE(3) operators
+# Twists and wrenches are ordered rotation first, V = [ω, v] and Γ = [τ, f], as in the
+# orbit-attitude papers; ``g = [[R, r], [0, 1]]`` maps body-frame coordinates to the
+# reference frame.
+
+
+@jit
+def se3_adjoint(g: np.ndarray) -> np.ndarray:
+    """Adjoint ``Ad_g = [[R, 0], [r^× R, R]]`` (6×6), so that ``(Ad_g V)^ = g V^ g⁻¹``."""
+    rotation = np.ascontiguousarray(g[:3, :3])
+    out = np.zeros((6, 6))
+    out[:3, :3] = rotation
+    out[3:, 3:] = rotation
+    out[3:, :3] = skew(np.ascontiguousarray(g[:3, 3])) @ rotation
+    return out
+
+
+@jit
+def se3_ad(twist: np.ndarray) -> np.ndarray:
+    """Adjoint of the Lie algebra, ``ad_V = [[ω^×, 0], [v^×, ω^×]]`` (6×6), the matrix of the
+    Lie bracket: ``ad_V W = [ω × η, ω × ψ - η × v]`` for ``W = [η, ψ]``."""
+    omega_x = skew(twist[:3])
+    out = np.zeros((6, 6))
+    out[:3, :3] = omega_x
+    out[3:, 3:] = omega_x
+    out[3:, :3] = skew(twist[3:])
+    return out
+
+
+@jit
+def se3_coad(twist: np.ndarray) -> np.ndarray:
+    """Co-adjoint ``ad*_V = ad_Vᵀ = [[-ω^×, -v^×], [0, -ω^×]]`` (6×6).
+
+    With ``Ξ = diag(J, m I)`` the free rigid body reads ``Ξ V̇ = ad*_V Ξ V``, i.e.
+    ``J ω̇ = -ω × Jω - v × m v`` and ``m v̇ = -ω × m v``.
+    """
+    return np.ascontiguousarray(se3_ad(twist).T)
+
+
+@jit
+def so3_right_jacobian_inverse(phi: np.ndarray) -> np.ndarray:
+    """``J_r⁻¹(φ) = I + ½ φ^× + (1/θ² - (1 + cos θ)/(2θ sin θ)) (φ^×)²`` for ``θ = ‖φ‖ < π``.
+
+    It maps a body-frame rate to the rate of the exponential coordinates:
+    ``Ṙ = R ω^×`` with ``R = exp(φ^×)`` gives ``φ̇ = J_r⁻¹(φ) ω``.
+    """
+    angle = np.sqrt(phi @ phi)
+    phi_x = skew(phi)
+    if angle < 0.1:
+        a2 = angle * angle
+        coefficient = 1.0 / 12.0 + a2 / 720.0 + a2 * a2 / 30240.0 + a2 * a2 * a2 / 1209600.0
+    else:
+        coefficient = 1.0 / angle**2 - (1.0 + np.cos(angle)) / (2.0 * angle * np.sin(angle))
+    return np.eye(3) + 0.5 * phi_x + coefficient * phi_x @ phi_x
+
+
+@jit
+def se3_left_jacobian_coupling(phi: np.ndarray, rho: np.ndarray) -> np.ndarray:
+    """The off-diagonal block ``Q(φ, ρ)`` of the left Jacobian of SE(3) (Barfoot's form).
+
+    ``J_l(ξ) = [[J_l(φ), 0], [Q(φ, ρ), J_l(φ)]]`` for ``ξ = [φ, ρ]``; series coefficients are
+    used below θ = 0.1, where the closed forms lose digits to cancellation.
+    """
+    angle = np.sqrt(phi @ phi)
+    a2 = angle * angle
+    if angle < 0.1:
+        c1 = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0 - a2 * a2 * a2 / 362880.0
+        c2 = 1.0 / 24.0 - a2 / 720.0 + a2 * a2 / 40320.0 - a2 * a2 * a2 / 3628800.0
+        c3 = 1.0 / 120.0 - a2 / 2520.0 + a2 * a2 / 120960.0 - a2 * a2 * a2 / 9979200.0
+    else:
+        s, c = np.sin(angle), np.cos(angle)
+        c1 = (angle - s) / angle**3
+        c2 = (a2 + 2.0 * c - 2.0) / (2.0 * a2 * a2)
+        c3 = (2.0 * angle - 3.0 * s + angle * c) / (2.0 * a2 * a2 * angle)
+    p = skew(phi)
+    r = skew(rho)
+    pr = p @ r
+    rp = r @ p
+    prp = pr @ p
+    pp = p @ p
+    return (
+        0.5 * r
+        + c1 * (pr + rp + prp)
+        + c2 * (pp @ r + rp @ p - 3.0 * prp)
+        + c3 * (prp @ p + pp @ r @ p)
+    )
+
+
+@jit
+def se3_right_jacobian_inverse(xi: np.ndarray) -> np.ndarray:
+    """``G(ξ) = J_r⁻¹(ξ) = [[A, 0], [T, A]]`` (6×6) for exponential coordinates ``ξ = [φ, ρ]``.
+
+    With ``g = exp(ξ^)`` and ``ġ = g V^`` (body-frame twist V), ``ξ̇ = G(ξ) V``. Here
+    ``A = J_r⁻¹(φ)`` and ``T = -A Q(-φ, -ρ) A``, since ``J_r(ξ) = J_l(-ξ)``.
+    """
+    phi = np.ascontiguousarray(xi[:3])
+    rho = np.ascontiguousarray(xi[3:])
+    a = so3_right_jacobian_inverse(phi)
+    out = np.zeros((6, 6))
+    out[:3, :3] = a
+    out[3:, 3:] = a
+    out[3:, :3] = -a @ se3_left_jacobian_coupling(-phi, -rho) @ a
+    return out
+
+
+# --------------------------------------------------------------------------- Euler angles
+@jit
+def quat_from_euler321(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """Unit quaternion of the 3-2-1 sequence (yaw ψ about z, pitch θ about the new y, roll φ
+    about the new x), so that ``attitude_matrix(q) = R1(φ) R2(θ) R3(ψ)``."""
+    cr, sr = np.cos(0.5 * roll), np.sin(0.5 * roll)
+    cp, sp = np.cos(0.5 * pitch), np.sin(0.5 * pitch)
+    cy, sy = np.cos(0.5 * yaw), np.sin(0.5 * yaw)
+    out = np.empty(4)
+    out[0] = sr * cp * cy - cr * sp * sy
+    out[1] = cr * sp * cy + sr * cp * sy
+    out[2] = cr * cp * sy - sr * sp * cy
+    out[3] = cr * cp * cy + sr * sp * sy
+    return out
+
+
+@jit
+def quat_to_euler321(q: np.ndarray) -> np.ndarray:
+    """``[roll, pitch, yaw]`` of the 3-2-1 sequence of :func:`quat_from_euler321` (pitch in
+    [-π/2, π/2], roll and yaw in (-π, π])."""
+    dcm = attitude_matrix(q)
+    out = np.empty(3)
+    out[0] = np.arctan2(dcm[1, 2], dcm[2, 2])
+    out[1] = -np.arcsin(min(1.0, max(-1.0, dcm[0, 2])))
+    out[2] = np.arctan2(dcm[0, 1], dcm[0, 0])
+    return out
+
+
+@jit
+def quat_angle(q: np.ndarray) -> float:
+    """Principal rotation angle ``2 atan2(‖q_v‖, |q4|)`` of a unit quaternion, in [0, π]."""
+    return 2.0 * np.arctan2(np.sqrt(q[:3] @ q[:3]), abs(q[3]))
