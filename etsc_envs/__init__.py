@@ -8,6 +8,7 @@ from gymnasium.envs.registration import register, registry
 
 ENV_IDS = {
     "etsc/AttitudeTracking-v0": "etsc_envs.attitude_tracking.env:AttitudeTrackingEnv",
+    "etsc/OrbitAttitudeTracking-v0": "etsc_envs.orbit_attitude.env:OrbitAttitudeTrackingEnv",
     "etsc/InnerFormation-v0": "etsc_envs.inner_formation.env:InnerFormationEnv",
 }
 """Gymnasium id → entry point of every registered single-agent environment."""

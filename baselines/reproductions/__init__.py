@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
-from baselines.reproductions import attitude_tracking, inner_formation
+from baselines.reproductions import (
+    attitude_tracking,
+    inner_formation,
+    orbit_attitude,
+)
 
 REPRODUCTIONS = {
+    "000": orbit_attitude,
     "002": attitude_tracking,
     "004": inner_formation,
 }

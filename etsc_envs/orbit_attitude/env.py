@@ -1,0 +1,420 @@
+"""``etsc/OrbitAttitudeTracking-v0``: when should the controller send Γ_c to the thrusters?
+
+Paper 000's loop: a chaser tracks the pose of a virtual leader on SE(3); a finite-time ESO
+(eq. 14) estimates the total disturbance, the adaptive sliding-mode law (eq. 22) computes the
+force-and-torque command Γ_cout, and the thrusters hold the last transmitted command Γ_c by a
+zero-order hold (eq. 20). At every sampling instant the agent decides whether the controller
+transmits the current Γ_cout; the paper's rule is eq. (21).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.rotations import quat_from_rotation_vector, se3_exp
+from etsc_envs.orbit_attitude.closed_loop import (
+    N_CONTROLLER_STATE,
+    N_DIAGNOSTICS,
+    N_FEATURES,
+    closed_loop_step,
+    controller_view,
+    initial_view,
+    total_disturbance,
+    tracking_cost,
+)
+from etsc_envs.orbit_attitude.controller import ControllerGains, adaptive_gain
+from etsc_envs.orbit_attitude.dynamics import (
+    LeaderOrbit,
+    PlantModel,
+    thruster_outputs,
+)
+from etsc_envs.orbit_attitude.params import OrbitAttitudeParams
+
+_AXES = ("x", "y", "z")
+FEATURE_NAMES = (
+    *(f"ec1_{a}" for a in _AXES),
+    *(f"ec2_{a}" for a in _AXES),
+    *(f"s1_{a}" for a in _AXES),
+    *(f"s2_{a}" for a in _AXES),
+    *(f"phi_{a}" for a in _AXES),
+    *(f"chi_{a}" for a in _AXES),
+    *(f"dw_{a}" for a in _AXES),
+    *(f"dv_{a}" for a in _AXES),
+)
+"""Observation components before ``time_since_transmission_s`` (all body-frame components):
+
+* ``ec1_*`` — ē_c1, torque part of e_c = Γ_c - Γ_cout: held minus current command (N·m);
+* ``ec2_*`` — ē_c2, force part of e_c (N);
+* ``s1_*``, ``s2_*`` — S̄1 (rad/s) and S̄2 (m/s), the sliding variable S of section III-B;
+* ``phi_*`` — Φ, attitude part of η̃ = log(g_e) (rad);
+* ``chi_*`` — χ, position part of η̃ (m);
+* ``dw_*``, ``dv_*`` — Ṽ = [Δω (rad/s), Δv (m/s)], the velocity error of eq. (7).
+
+Eq. (21) reads ē_c1, ē_c2, S̄1 and S̄2 at the controller, the triggering side.
+"""
+
+COST_REFERENCE = np.array([np.deg2rad(4e-4), np.deg2rad(2e-3), 1e-5, 2e-6])
+"""The paper's steady-state bounds on |Φ_i| (4e-4 deg), |Δω_i| (2e-3 deg/s), |χ_i| (1e-5 m)
+and |Δv_i| (2e-6 m/s), in rad, rad/s, m, m/s: the per-step cost is
+``¼ Σ log(1 + ‖x‖/ref)`` over these four errors (equal weights ¼)."""
+
+STEADY_STATE_FRACTION = 0.2
+"""The ``ss_*`` and ``eso_ss_err`` metrics are maxima over the last 20 % of the horizon."""
+SETTLING_BAND = 0.02
+"""``settle_*_s``: the time after which ‖Φ‖ (‖χ‖) stays within 2 % of its initial value."""
+
+RANDOM_ATTITUDE_MAX_DEG = 100.0
+"""``randomize=True``: ‖Φ(0)‖ uniform in [0, 100] deg (P1 is 98.4 deg)."""
+RANDOM_POSITION_MAX_M = 60.0
+"""``randomize=True``: ‖χ(0)‖ uniform in [0, 60] m (P2 is 55.9 m). Larger starts can diverge:
+the saturated force demand pins every thruster and leaves no torque (docs/drafts)."""
+
+
+def _six(pair) -> np.ndarray:
+    """A (rotational, translational) pair as the diagonal of diag(x1 I3, x2 I3)."""
+    return np.repeat(np.asarray(pair, dtype=float), 3)
+
+
+def make_leader(params: OrbitAttitudeParams, raan_rad: float, latitude_rad: float) -> LeaderOrbit:
+    """The virtual leader's circular orbit."""
+    return LeaderOrbit(
+        mu=float(params.gravitational_parameter),
+        radius=params.leader_radius_m,
+        rate=params.leader_rate_rad_s,
+        raan=float(raan_rad),
+        inclination=math.radians(params.leader_inclination_deg),
+        latitude_argument0=float(latitude_rad),
+    )
+
+
+def make_plant_model(
+    params: OrbitAttitudeParams,
+    leader: LeaderOrbit,
+    misalignment: np.ndarray,
+    torque_phase: np.ndarray | None = None,
+    force_phase: np.ndarray | None = None,
+) -> PlantModel:
+    """The true plant: J + ΔJ, m + Δm, D + ΔD, bias, disturbances (section IV)."""
+    distribution = params.distribution_matrix()
+    inertia = params.true_inertia
+    on = 1.0 if params.disturbances else 0.0
+    return PlantModel(
+        leader=leader,
+        earth_radius=float(params.earth_radius_m),
+        j2=float(params.j2),
+        inertia=inertia,
+        inertia_inv=np.linalg.inv(inertia),
+        mass=params.true_mass_kg,
+        distribution=distribution + misalignment,
+        allocation=np.linalg.pinv(distribution),
+        max_force=float(params.thruster_max_force_n),
+        bias_ratio=float(params.thruster_bias_ratio),
+        torque_offset=on * np.asarray(params.torque_disturbance_offset, dtype=float),
+        torque_amplitude=on * np.asarray(params.torque_disturbance_amplitude, dtype=float),
+        torque_frequency=np.asarray(params.torque_disturbance_frequency, dtype=float),
+        torque_phase=np.asarray(
+            params.torque_disturbance_phase if torque_phase is None else torque_phase, dtype=float
+        ),
+        force_offset=on * np.asarray(params.force_disturbance_offset, dtype=float),
+        force_amplitude=on * np.asarray(params.force_disturbance_amplitude, dtype=float),
+        force_frequency=2.0 * math.pi * params.leader_rate_rad_s,
+        force_phase=np.asarray(
+            params.force_disturbance_phase if force_phase is None else force_phase, dtype=float
+        ),
+    )
+
+
+def make_controller_gains(params: OrbitAttitudeParams, leader: LeaderOrbit) -> ControllerGains:
+    """The controller's nominal model and design parameters (section IV)."""
+    inertia = np.asarray(params.nominal_inertia, dtype=float)
+    distribution = params.distribution_matrix()
+    ref19 = 0.0 if params.observer == "ref19" else 1.0
+    return ControllerGains(
+        leader=leader,
+        earth_radius=float(params.earth_radius_m),
+        j2=float(params.j2),
+        inertia=inertia,
+        inertia_inv=np.linalg.inv(inertia),
+        mass=float(params.nominal_mass_kg),
+        theta1=_six(params.surface_theta1),
+        theta2=_six(params.surface_theta2),
+        alpha=float(params.surface_alpha),
+        singularity_floor=float(params.singularity_floor),
+        beta=float(params.eso_beta),
+        alpha1=float(params.eso_alpha1),
+        alpha2=float(params.eso_alpha2),
+        k1=_six(params.eso_k1),
+        k2=ref19 * _six(params.eso_k2),
+        k3=_six(params.eso_k3),
+        k4=ref19 * _six(params.eso_k4),
+        k5=ref19 * _six(params.eso_k5),
+        gain_k1=_six(params.gain_k1),
+        gain_k2=_six(params.gain_k2),
+        ell=np.asarray(params.adaptive_ell, dtype=float),
+        epsilon=np.asarray(params.adaptive_epsilon, dtype=float),
+        sigma=np.asarray(params.adaptive_sigma, dtype=float),
+        distribution=distribution,
+        allocation=np.linalg.pinv(distribution),
+        max_force=float(params.thruster_max_force_n),
+        eso_sees_saturation=params.eso_input == "saturated",
+    )
+
+
+def initial_state(phi_rad: np.ndarray, chi_m: np.ndarray, twist_error: np.ndarray) -> np.ndarray:
+    """The plant state ``[q_e, r_e, Δω, Δv]`` with ``g_e = exp([Φ, χ]^)`` and ``Ṽ`` (eq. 6)."""
+    y = np.empty(13)
+    y[0:4] = quat_from_rotation_vector(np.asarray(phi_rad, dtype=float))
+    y[4:7] = se3_exp(np.concatenate([phi_rad, chi_m]))[:3, 3]
+    y[7:13] = twist_error
+    return y
+
+
+class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
+    """Coupled orbit-attitude tracking with an event-triggered control channel (paper 000).
+
+    Args:
+        params: the paper's model and scenario; keyword overrides of its fields (for example
+            ``initial_point="P2"``, ``observer="ref19"``, ``horizon_s=100``) are applied on top.
+        transmission_penalty: λ, reward lost per transmission of Γ_c.
+        cost_scale: the per-step accuracy cost (:data:`COST_REFERENCE`) is divided by this.
+            A failed episode is charged the cost at the failure bounds for every step it cuts
+            from the horizon.
+        randomize: at every reset draw the initial attitude error (uniform axis, angle uniform
+            in [0, 100] deg), the initial position error (uniform direction, norm uniform in
+            [0, 60] m; the paper's P1 and P2 span these ranges), the leader's node and phase
+            (uniform in [0, 2π)), the phases of the six disturbance sinusoids (uniform in
+            [0, 2π)) and the misalignment ΔD, instead of the paper's fixed values. Ṽ(0) stays
+            ``initial_velocity_error`` (zero in the paper).
+
+    Action: ``Discrete(2)``, 1 transmits the current Γ_cout to the thrusters. Observation: the
+    components named in :data:`FEATURE_NAMES` followed by ``time_since_transmission_s``.
+    """
+
+    def __init__(
+        self,
+        params: OrbitAttitudeParams | None = None,
+        *,
+        transmission_penalty: float = 1.0,
+        cost_scale: float = 1.0,
+        randomize: bool = False,
+        **overrides: Any,
+    ) -> None:
+        params = params if params is not None else OrbitAttitudeParams()
+        unknown = set(overrides) - {field.name for field in dataclasses.fields(params)}
+        if unknown:
+            raise TypeError(f"unknown argument(s) for OrbitAttitudeTrackingEnv: {sorted(unknown)}")
+        self.params = dataclasses.replace(params, **overrides)
+        if not isinstance(randomize, bool | np.bool_):
+            raise ValueError(f"randomize must be True or False, got {randomize!r}")
+        self.randomize = bool(randomize)
+        p = self.params
+        low = np.full(N_FEATURES, -np.inf)
+        high = np.full(N_FEATURES, np.inf)
+        phi_slice = slice(FEATURE_NAMES.index("phi_x"), FEATURE_NAMES.index("phi_z") + 1)
+        low[phi_slice], high[phi_slice] = -np.pi, np.pi
+        failure_eta = np.array([np.pi, 0, 0, p.max_position_error_m, 0, 0])
+        failure_twist = np.array([p.max_rate_error_rad_s, 0, 0, p.max_velocity_error_m_s, 0, 0])
+        super().__init__(
+            feature_names=FEATURE_NAMES,
+            feature_low=low,
+            feature_high=high,
+            n_channels=1,
+            channel_width=6,
+            sampling_period_s=p.sampling_period_s,
+            horizon_s=p.horizon_s,
+            transmission_penalty=transmission_penalty,
+            cost_scale=cost_scale,
+            failure_cost=float(tracking_cost(failure_eta, failure_twist, COST_REFERENCE)),
+        )
+        self._steady_start = round((1.0 - STEADY_STATE_FRACTION) * self.n_steps)
+        self.plant_state = np.zeros(13)
+        self.controller_state = np.zeros(N_CONTROLLER_STATE)
+        self._features_now = np.zeros(N_FEATURES)
+        self._fresh_command = np.zeros(6)
+        self._thruster_output = np.zeros(12)
+        self._eso_errors = np.zeros(12)
+        self._diagnostics = np.zeros(N_DIAGNOSTICS)
+        self._view = np.zeros(12)
+        self.misalignment = np.zeros((6, 12))
+
+    # ----------------------------------------------------------------- hooks
+    def _reset_problem(self, options: dict[str, Any] | None) -> None:
+        p = self.params
+        rng = self.np_random
+        phi, chi = p.initial_error()
+        raan = math.radians(p.leader_raan_deg)
+        latitude = math.radians(p.leader_latitude_argument_deg)
+        torque_phase = force_phase = None
+        if p.misalignment_seed is None or self.randomize:
+            self.misalignment = p.misalignment_std * rng.normal(size=(6, 12))
+        else:
+            fixed = np.random.default_rng(p.misalignment_seed)
+            self.misalignment = p.misalignment_std * fixed.normal(size=(6, 12))
+        if self.randomize:
+            axis = rng.normal(size=3)
+            axis /= np.linalg.norm(axis)
+            phi = np.deg2rad(rng.uniform(0.0, RANDOM_ATTITUDE_MAX_DEG)) * axis
+            direction = rng.normal(size=3)
+            direction /= np.linalg.norm(direction)
+            chi = rng.uniform(0.0, RANDOM_POSITION_MAX_M) * direction
+            raan, latitude = rng.uniform(0.0, 2.0 * np.pi, size=2)
+            torque_phase = rng.uniform(0.0, 2.0 * np.pi, size=3)
+            force_phase = rng.uniform(0.0, 2.0 * np.pi, size=3)
+        self.leader = make_leader(p, raan, latitude)
+        self.model = make_plant_model(p, self.leader, self.misalignment, torque_phase, force_phase)
+        self.gains = make_controller_gains(p, self.leader)
+        self.initial_eta = np.concatenate([phi, chi])
+        self.plant_state = initial_state(
+            phi, chi, np.asarray(p.initial_velocity_error, dtype=float)
+        )
+        c = np.zeros(N_CONTROLLER_STATE)
+        c[12:14] = p.adaptive_phi0
+        eta, self._view, command = initial_view(self.plant_state, c, self.gains)
+        surface = self._view[0:6]
+        if p.observer_start == "first_measurement":
+            c[0:6] = surface
+        self.controller_state = c
+        self._fresh_command = command
+        self._features_now = np.zeros(N_FEATURES)
+        self._features_now[6:12] = surface
+        self._features_now[12:18] = eta
+        self._features_now[18:24] = self.plant_state[7:13]
+        self._thruster_output = thruster_outputs(command, self.model)[1]
+        self._eso_errors = np.zeros(12)
+        self._counted = 0
+        # running episode statistics: steady-state maxima, settling, impulse
+        self._steady_max = np.zeros(8)
+        self._impulse = 0.0
+        initial_norms = (float(np.linalg.norm(phi)), float(np.linalg.norm(chi)))
+        self._settling_bounds = tuple(SETTLING_BAND * n for n in initial_norms)
+        self._settle = [None if n > 0.0 else 0.0 for n in initial_norms]
+
+    def _channel_values(self) -> np.ndarray:
+        return self._fresh_command
+
+    def _advance(self) -> float:
+        transmissions = int(self.channel.transmissions[0])
+        if transmissions != self._counted:  # a transmission at t_k restarts ∫_{t_k} ϕ̂ ds
+            self._counted = transmissions
+            self.controller_state[14:16] = 0.0
+        steady = self.step_index + 1 > self._steady_start
+        (
+            self.plant_state,
+            self.controller_state,
+            self._fresh_command,
+            self._features_now,
+            self._view,
+            cost,
+            diagnostics,
+            self._eso_errors[0:6],
+            self._eso_errors[6:12],
+            self._thruster_output,
+        ) = closed_loop_step(
+            self.time_s,
+            self.sampling_period_s,
+            self.params.plant_substeps,
+            self.plant_state,
+            self.controller_state,
+            self.channel.held[0],
+            self.model,
+            self.gains,
+            self._view,
+            COST_REFERENCE,
+            steady,
+        )
+        self._diagnostics = diagnostics
+        self._impulse += diagnostics[10]
+        time_next = (self.step_index + 1) * self.sampling_period_s
+        for i in (0, 1):
+            if diagnostics[i] > self._settling_bounds[i]:
+                self._settle[i] = None
+            elif self._settle[i] is None:
+                self._settle[i] = time_next
+        if steady:
+            np.maximum(self._steady_max, diagnostics[2:10], out=self._steady_max)
+        return float(cost)
+
+    def _failure(self) -> str | None:
+        d = self._diagnostics
+        if d[13] != 1.0:
+            return "non-finite state"
+        p = self.params
+        if (
+            d[1] > p.max_position_error_m
+            or d[11] > p.max_rate_error_rad_s
+            or (d[12] > p.max_velocity_error_m_s)
+        ):
+            for name, value, bound, unit in (
+                ("chi", d[1], p.max_position_error_m, "m"),
+                ("dw", d[11], p.max_rate_error_rad_s, "rad/s"),
+                ("dv", d[12], p.max_velocity_error_m_s, "m/s"),
+            ):
+                if value > bound:
+                    return f"diverged: |{name}| = {value:.4g} {unit} > {bound:g} {unit}"
+        return None
+
+    def _features(self) -> np.ndarray:
+        return self._features_now
+
+    def _paper_metrics(self) -> dict[str, Any]:
+        reached = self.step_index > self._steady_start
+        steady = self._steady_max if reached else np.full(8, np.nan)
+
+        def value(x: float, scale: float = 1.0) -> float | None:
+            return None if not np.isfinite(x) else float(x) * scale
+
+        deg = 180.0 / np.pi
+        return {
+            "ss_att_err_deg": value(steady[0], deg),
+            "ss_angvel_err_degps": value(steady[1], deg),
+            "ss_pos_err_m": value(steady[2]),
+            "ss_vel_err_mps": value(steady[3]),
+            "settle_att_s": self._settle[0],
+            "settle_pos_s": self._settle[1],
+            "eso_ss_err": {
+                "e1_rot": value(steady[4]),
+                "e1_trans": value(steady[5]),
+                "e2_rot_Nm": value(steady[6]),
+                "e2_trans_N": value(steady[7]),
+            },
+            "thruster_impulse_Ns": float(self._impulse),
+        }
+
+    # ----------------------------------------------------------------- diagnostics
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """Named copies of the loop's signals at the current instant (for plots and tests).
+
+        ``thruster_output`` is u_a over the sampling period that ended at this instant; ``e1``
+        and ``e2`` are the ESO errors of eq. (15), e2 against the true Δd with the command held
+        now (``held_command``).
+        """
+        t = self.time_s
+        c = self.controller_state
+        eta, surface, _, known, command, fresh = controller_view(t, self.plant_state, c, self.gains)
+        held = self.channel.held[0].copy()
+        wrench = thruster_outputs(held, self.model)[2]
+        disturbance = total_disturbance(
+            t, self.plant_state, wrench, held, known, self.model, self.gains
+        )
+        return {
+            "time_s": np.array(t),
+            "eta": eta,
+            "twist_error": self.plant_state[7:13].copy(),
+            "surface": surface,
+            "z1_hat": c[0:6].copy(),
+            "z2_hat": c[6:12].copy(),
+            "total_disturbance": disturbance,
+            "e1": c[0:6] - surface,
+            "e2": c[6:12] - disturbance,
+            "phi_hat": c[12:14].copy(),
+            "k3": adaptive_gain(c[12:14], c[14:16], surface, t, self.gains),
+            "command": command,
+            "fresh_command": fresh,
+            "held_command": held,
+            "thruster_output": self._thruster_output.copy(),
+        }
