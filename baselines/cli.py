@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +42,48 @@ def parse_assignments(pairs: list[str] | None, option: str) -> dict[str, Any]:
 
 def make_policy(spec: str, env: gym.Env, policy_args: dict[str, Any], env_id: str) -> Any:
     """The policy named by ``spec`` (see :data:`POLICY_CHOICES`) for ``env``."""
-    observation_space, action_space = env.observation_space, env.action_space
+    return _policy_for(
+        spec,
+        env.observation_space,
+        env.action_space,
+        lambda: env.unwrapped.observation_names,
+        policy_args,
+        env_id,
+    )
+
+
+def make_agent_policy(spec: str, env: Any, policy_args: dict[str, Any], env_id: str) -> Any:
+    """The policy named by ``spec`` shared by every agent of a PettingZoo ``ParallelEnv``.
+
+    The agents must have equal spaces; the policy is queried with the agents' observations
+    stacked along the batch axis, one action per agent.
+    """
+    agent = env.possible_agents[0]
+    if any(
+        env.observation_space(other) != env.observation_space(agent)
+        or env.action_space(other) != env.action_space(agent)
+        for other in env.possible_agents
+    ):
+        raise ValueError(f"the agents of {env_id} differ in their spaces; no policy serves all")
+    return _policy_for(
+        spec,
+        env.observation_space(agent),
+        env.action_space(agent),
+        lambda: env.unwrapped.agent_observation_names,
+        policy_args,
+        env_id,
+    )
+
+
+def _policy_for(
+    spec: str,
+    observation_space: gym.Space,
+    action_space: gym.Space,
+    observation_names: Callable[[], tuple[str, ...]],
+    policy_args: dict[str, Any],
+    env_id: str,
+) -> Any:
+    """The policy named by ``spec`` for the given spaces (names are read only if needed)."""
     if spec == "always":
         return AlwaysPolicy(observation_space, action_space, **policy_args)
     if spec == "periodic":
@@ -49,7 +91,7 @@ def make_policy(spec: str, env: gym.Env, policy_args: dict[str, Any], env_id: st
     if spec == "paper":
         if env_id not in PAPER_TRIGGERS:
             raise ValueError(f"no paper trigger for {env_id}; known: {sorted(PAPER_TRIGGERS)}")
-        names = env.unwrapped.observation_names
+        names = observation_names()
         return PAPER_TRIGGERS[env_id](observation_space, action_space, names, **policy_args)
     if spec.startswith("sb3:"):
         if policy_args:

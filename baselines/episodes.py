@@ -100,9 +100,87 @@ def run_episode(
     return record, trace
 
 
+def run_parallel_episode(
+    env: Any,
+    policy: Any,
+    seed: int | None = None,
+    *,
+    sample_every: int | None = None,
+    progress: bool = False,
+    description: str = "",
+) -> tuple[dict[str, Any], EpisodeTrace]:
+    """Run one episode of a PettingZoo ``ParallelEnv`` with ``policy`` shared by all agents.
+
+    The agents' observations are stacked (in ``env.possible_agents`` order) and answered by
+    one ``predict`` call per step, so a recurrent ``state`` holds one row per agent. The trace
+    pools the agents' costs per step and keeps each step's transmit bits in
+    ``transmission_actions`` (see :meth:`EpisodeTrace.channel_transmission_times`).
+
+    Returns the episode record (as :func:`run_episode`, with ``return`` summed over agents and
+    each agent's own ``return`` under ``agents``) and the trace.
+    """
+    trace = EpisodeTrace()
+    unwrapped = env.unwrapped
+    names = list(env.possible_agents)
+    sampler: Callable | None = getattr(unwrapped, "state_dict", None) if sample_every else None
+    observations, _ = env.reset(seed=seed)
+    state, episode_start = None, np.ones(len(names), dtype=bool)
+    returns = np.zeros(len(names))
+    steps = 0
+    bar = tqdm(
+        total=getattr(unwrapped, "n_steps", None),
+        disable=not progress,
+        desc=description,
+        unit="step",
+        leave=False,
+        mininterval=0.5,
+    )
+    started = time.perf_counter()
+    if sampler is not None:
+        trace.samples.append(sampler())
+    infos: dict[str, Any] = {}
+    while env.agents:
+        batch = np.stack([observations[agent] for agent in names])
+        actions, state = policy.predict(
+            batch, state=state, episode_start=episode_start, deterministic=True
+        )
+        episode_start = np.zeros(len(names), dtype=bool)
+        bits = np.asarray(actions).reshape(len(names))
+        time_before = unwrapped.time_s
+        observations, rewards, _, _, infos = env.step(
+            {agent: int(bits[i]) for i, agent in enumerate(names)}
+        )
+        steps += 1
+        returns += [rewards[agent] for agent in names]
+        first = infos[names[0]]
+        trace.time_s.append(first["time_s"])
+        trace.cost.append(sum(infos[agent]["cost"] for agent in names))
+        if bits.any():
+            trace.transmission_times_s.append(time_before)
+            trace.transmission_actions.append(bits.copy())
+        if sampler is not None and steps % sample_every == 0:
+            trace.samples.append(sampler())
+        if steps % 1000 == 0:
+            bar.update(1000)
+    bar.close()
+    metrics = infos[names[0]]["episode_metrics"]
+    record = {
+        "seed": seed,
+        "wall_time_s": time.perf_counter() - started,
+        "return": float(returns.sum()),
+        **metrics,
+    }
+    record["agents"] = {
+        agent: {"return": float(returns[i]), **metrics.get("agents", {}).get(agent, {})}
+        for i, agent in enumerate(names)
+    }
+    return record, trace
+
+
 def mean_record(records: list[dict[str, Any]]) -> dict[str, Any]:
     """Mean of every numeric key over episodes (keys that are ``None`` somewhere are skipped),
-    plus ``failures``, the number of failed episodes."""
+    plus ``failures``, the number of failed episodes, and for multi-agent records the mean of
+    each agent's numeric keys under ``agents``."""
     mean: dict[str, Any] = {}
     for key in records[0]:
         values = [record.get(key) for record in records]
@@ -110,7 +188,21 @@ def mean_record(records: list[dict[str, Any]]) -> dict[str, Any]:
             continue
         mean[key] = float(np.mean(values))
     mean["failures"] = sum(record.get("failure") is not None for record in records)
+    if all(isinstance(record.get("agents"), dict) for record in records):
+        mean["agents"] = {
+            agent: _numeric_mean([record["agents"].get(agent, {}) for record in records])
+            for agent in records[0]["agents"]
+        }
     return mean
+
+
+def _numeric_mean(records: list[dict[str, Any]]) -> dict[str, float]:
+    """Mean of every key that is a number in all ``records``."""
+    return {
+        key: float(np.mean([record[key] for record in records]))
+        for key in records[0]
+        if all(isinstance(record.get(key), int | float) for record in records)
+    }
 
 
 def to_jsonable(value: Any) -> Any:

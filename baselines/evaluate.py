@@ -16,8 +16,15 @@ from typing import Any
 
 import gymnasium as gym
 
-from baselines.cli import POLICY_CHOICES, make_policy, parse_assignments, write_json
-from baselines.episodes import mean_record, run_episode
+import etsc_envs
+from baselines.cli import (
+    POLICY_CHOICES,
+    make_agent_policy,
+    make_policy,
+    parse_assignments,
+    write_json,
+)
+from baselines.episodes import mean_record, run_episode, run_parallel_episode
 from baselines.plotting import plot_episode
 
 
@@ -35,15 +42,23 @@ def evaluate(
     """Run ``episodes`` episodes (seeds ``seed, seed+1, ...``) and return the design page's JSON.
 
     Returns ``{"env", "policy", "policy_args", "env_args", "episodes": [...], "mean": {...}}``.
+    For a PettingZoo id (:data:`etsc_envs.PETTINGZOO_ENV_IDS`) one policy serves every agent
+    and the records also hold each agent's values under ``agents``.
     """
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     policy_args, env_args = dict(policy_args or {}), dict(env_args or {})
-    env = gym.make(env_id, **env_args)
-    trigger = make_policy(policy, env, policy_args, env_id)
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env = etsc_envs.make_parallel(env_id, **env_args)
+        trigger = make_agent_policy(policy, env, policy_args, env_id)
+        runner = run_parallel_episode
+    else:
+        env = gym.make(env_id, **env_args)
+        trigger = make_policy(policy, env, policy_args, env_id)
+        runner = run_episode
     records = []
     for episode in range(episodes):
-        record, trace = run_episode(
+        record, trace = runner(
             env,
             trigger,
             seed + episode,
@@ -72,7 +87,10 @@ def main(argv: list[str] | None = None) -> int:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("env_id", help="a registered id, e.g. etsc/AttitudeTracking-v0")
+    parser.add_argument(
+        "env_id",
+        help="a registered Gymnasium or PettingZoo id, e.g. etsc/AttitudeTracking-v0",
+    )
     parser.add_argument("--policy", required=True, help=POLICY_CHOICES)
     parser.add_argument("--policy-arg", action="append", metavar="K=V", help="policy parameter")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
@@ -99,7 +117,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.json != "-":
         print(f"{result['env']}  policy={result['policy']} {result['policy_args'] or ''}")
         for key, value in result["mean"].items():
-            print(f"  {key:>22s}  {value:.6g}")
+            if not isinstance(value, dict):
+                print(f"  {key:>22s}  {value:.6g}")
+        for agent, values in result["mean"].get("agents", {}).items():
+            print(f"  {agent}: " + ", ".join(f"{k}={v:.6g}" for k, v in values.items()))
     return 0
 
 

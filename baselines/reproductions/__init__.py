@@ -4,12 +4,14 @@ from __future__ import annotations
 
 from baselines.reproductions import (
     attitude_tracking,
+    cluster,
     inner_formation,
     orbit_attitude,
 )
 
 REPRODUCTIONS = {
     "000": orbit_attitude,
+    "001": cluster,
     "002": attitude_tracking,
     "004": inner_formation,
 }

@@ -1,0 +1,228 @@
+"""PettingZoo view of a multi-channel event-triggered loop: one agent per channel.
+
+A problem whose paper triggers several channels separately (one per spacecraft of a
+formation, say) writes its closed loop once, as an :class:`~etsc_envs.core.loop.EventTriggeredEnv`
+with ``n_channels = N`` (a ``MultiBinary(N)`` Gymnasium env for a central trigger), and gets
+the decentralised multi-agent form from :class:`EventTriggeredParallelEnv`, which shares that
+loop: the agents' transmit bits are gathered into the loop's action, each agent observes its
+own block of the loop's observation plus its own transmission clock, and pays its own cost.
+
+What the loop must provide (besides the :class:`EventTriggeredEnv` API):
+
+* ``agent_names``: one name per channel, in channel order;
+* ``agent_feature_names``: the names of one agent's features; the loop's observation starts
+  with every agent's features, agent after agent, named by :func:`agent_major_names`;
+* ``channel_costs``: each channel's share of the last step's cost (they sum to the cost).
+
+Per agent, the reward is ``-(cost_i + failure share)/cost_scale - transmission_penalty *
+sent_i``, where ``sent_i`` counts a transmission the loop accepted and a failure charges each
+agent ``failure_cost / N`` per step cut from the horizon, so the agents' rewards always sum to
+the central env's reward.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+from pettingzoo import ParallelEnv
+
+from etsc_envs.core.channel import HeldChannel
+from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.metrics import interevent_summary
+
+CLOCK_NAME = "time_since_transmission_s"
+
+
+def agent_major_names(feature_names: tuple[str, ...], n_agents: int) -> tuple[str, ...]:
+    """``name_i`` for every agent ``i`` and feature ``name``, agent after agent."""
+    return tuple(f"{name}_{i}" for i in range(n_agents) for name in feature_names)
+
+
+def agent_metrics(
+    channel: HeldChannel, steps: int, agent_names: tuple[str, ...]
+) -> dict[str, dict[str, Any]]:
+    """Communication record of each agent's channel: ``transmissions``, ``transmission_rate``
+    (per sampling instant), ``mean_interevent_s`` and ``min_interevent_s``."""
+    record = {}
+    for index, name in enumerate(agent_names):
+        mean_s, min_s = interevent_summary(channel.interevent_s[index])
+        transmissions = int(channel.transmissions[index])
+        record[name] = {
+            "transmissions": transmissions,
+            "transmission_rate": transmissions / steps if steps else 0.0,
+            "mean_interevent_s": mean_s,
+            "min_interevent_s": min_s,
+        }
+    return record
+
+
+class EventTriggeredParallelEnv(ParallelEnv):
+    """Decentralised transmit-or-hold decisions over one shared multi-channel loop.
+
+    Args:
+        loop: the shared closed loop (see the module docstring for what it must provide).
+
+    Agents: ``loop.agent_names``. Each acts with ``Discrete(2)`` (1 transmits its channel) and
+    observes ``agent_observation_names``: its features followed by
+    ``time_since_transmission_s``. ``state()`` is the loop's whole observation. All agents
+    end together: terminated on a failure of the loop (``infos[agent]["failure"]``), truncated
+    at the horizon; the last infos also hold ``episode_metrics``.
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {
+        "name": "event_triggered_parallel_v0",
+        "render_modes": [],
+        "is_parallelizable": True,
+    }
+
+    def __init__(self, loop: EventTriggeredEnv) -> None:
+        self.loop = loop
+        n_agents = loop.channel.n_channels
+        feature_names = tuple(loop.agent_feature_names)
+        n_features = len(feature_names)
+        if len(loop.agent_names) != n_agents:
+            raise ValueError(f"loop.agent_names must name {n_agents} agents (one per channel)")
+        if loop.observation_names[: n_agents * n_features] != agent_major_names(
+            feature_names, n_agents
+        ):
+            raise ValueError("the loop's observation must start with agent_major_names(...)")
+        self.possible_agents = list(loop.agent_names)
+        self.agents: list[str] = []
+        self.render_mode = None
+        self.agent_observation_names = (*feature_names, CLOCK_NAME)
+        clock_start = len(loop.observation_names) - n_agents
+        self._index = np.array(
+            [
+                [*range(i * n_features, (i + 1) * n_features), clock_start + i]
+                for i in range(n_agents)
+            ]
+        )
+        box = loop.observation_space
+        self._observation_spaces = {
+            agent: gym.spaces.Box(box.low[rows], box.high[rows], dtype=np.float32)
+            for agent, rows in zip(self.possible_agents, self._index, strict=True)
+        }
+        self._action_spaces = {agent: gym.spaces.Discrete(2) for agent in self.possible_agents}
+        self.state_space = box
+        self._state = np.zeros(box.shape, dtype=np.float32)
+
+    # ----------------------------------------------------------------- spaces
+    def observation_space(self, agent: str) -> gym.spaces.Box:
+        return self._observation_spaces[agent]
+
+    def action_space(self, agent: str) -> gym.spaces.Discrete:
+        return self._action_spaces[agent]
+
+    def observation_index(self, name: str) -> int:
+        """Position of the named component in every agent's observation."""
+        return self.agent_observation_names.index(name)
+
+    # ----------------------------------------------------------------- PettingZoo API
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
+        observation, _ = self.loop.reset(seed=seed, options=options)
+        self.agents = list(self.possible_agents)
+        infos = {
+            agent: {"transmitted": 0, "transmissions": 0, "time_s": 0.0, "cost": 0.0}
+            for agent in self.agents
+        }
+        return self._split(observation), infos
+
+    def step(self, actions: dict[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
+        if not self.agents:
+            raise RuntimeError("step() called after the episode ended; call reset() first")
+        bits = self._bits(actions)
+        loop = self.loop
+        before = loop.channel.transmissions.copy()
+        observation, _, terminated, truncated, info = loop.step(bits)
+        sent = loop.channel.transmissions - before  # the loop may refuse a request
+        costs = np.asarray(loop.channel_costs, dtype=float)
+        if not np.isfinite(costs.sum()):  # as the loop does: a non-finite step costs nothing
+            costs = np.zeros_like(costs)
+        step_costs = costs
+        if terminated:
+            costs = costs + loop.failure_cost / len(sent) * (loop.n_steps - loop.step_index)
+        rewards = -costs / loop.cost_scale - loop.transmission_penalty * sent
+        observations = self._split(observation)
+        names = self.possible_agents
+        infos = {}
+        for i, agent in enumerate(names):
+            agent_info = {
+                "transmitted": int(sent[i]),
+                "transmissions": int(loop.channel.transmissions[i]),
+                "time_s": info["time_s"],
+                "cost": float(step_costs[i]),
+            }
+            for key in ("failure", "episode_metrics"):
+                if key in info:
+                    agent_info[key] = info[key]
+            infos[agent] = agent_info
+        self.agents = [] if terminated or truncated else self.agents
+        return (
+            observations,
+            {agent: float(rewards[i]) for i, agent in enumerate(names)},
+            dict.fromkeys(names, bool(terminated)),
+            dict.fromkeys(names, bool(truncated)),
+            infos,
+        )
+
+    def state(self) -> np.ndarray:
+        """The loop's whole observation at the current instant (every agent's view)."""
+        return self._state.copy()
+
+    def close(self) -> None:
+        self.loop.close()
+
+    # ----------------------------------------------------------------- extras
+    def episode_metrics(self) -> dict[str, Any]:
+        """The loop's episode record so far (common keys, the paper's and per-agent ones)."""
+        return self.loop.episode_metrics()
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """Named copies of the loop's signals (for plots and tests)."""
+        return self.loop.state_dict()
+
+    @property
+    def time_s(self) -> float:
+        """Simulated time of the current sampling instant."""
+        return self.loop.time_s
+
+    @property
+    def n_steps(self) -> int:
+        """Sampling instants in a full episode."""
+        return self.loop.n_steps
+
+    # ----------------------------------------------------------------- internals
+    def _split(self, observation: np.ndarray) -> dict[str, np.ndarray]:
+        self._state = observation
+        blocks = observation[self._index]
+        return {agent: blocks[i] for i, agent in enumerate(self.possible_agents)}
+
+    def _bits(self, actions: dict[str, Any]) -> np.ndarray:
+        """One 0/1 per agent, or ``ValueError`` naming the agent or action that is wrong."""
+        names = self.possible_agents
+        if len(actions) != len(names) or any(agent not in actions for agent in names):
+            missing = [agent for agent in names if agent not in actions]
+            unknown = sorted(set(actions) - set(names))
+            raise ValueError(
+                f"actions must hold one entry per live agent; missing {missing}, unknown {unknown}"
+            )
+        values = [actions[agent] for agent in names]
+        try:
+            bits = np.array(values)
+        except ValueError:  # ragged: some action is not a scalar
+            bits = np.zeros(0)
+        if (
+            bits.shape != (len(names),)
+            or bits.dtype.kind not in "biuf"
+            or not np.all((bits == 0) | (bits == 1))
+        ):
+            for agent, value in zip(names, values, strict=True):
+                if np.ndim(value) != 0 or isinstance(value, str) or value not in (0, 1):
+                    raise ValueError(
+                        f"action of {agent} must be 0 (hold) or 1 (transmit), got {value!r}"
+                    )
+        return bits.astype(np.int64)
