@@ -12,6 +12,7 @@ ENV_IDS = {
     "etsc/OrbitAttitudeTracking-v0": "etsc_envs.orbit_attitude.env:OrbitAttitudeTrackingEnv",
     "etsc/ClusterContainmentCentral-v0": "etsc_envs.cluster.env:ClusterContainmentCentralEnv",
     "etsc/InnerFormation-v0": "etsc_envs.inner_formation.env:InnerFormationEnv",
+    "etsc/AsteroidOrbitKeeping-v0": "etsc_envs.asteroid.env:AsteroidOrbitKeepingEnv",
 }
 """Gymnasium id → entry point of every registered single-agent environment."""
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from baselines.triggers.asteroid import AsteroidOrbitKeepingTrigger
 from baselines.triggers.attitude_tracking import AttitudeTrackingTrigger
 from baselines.triggers.cluster import ClusterContainmentTrigger
 from baselines.triggers.inner_formation import InnerFormationTrigger
@@ -13,5 +14,6 @@ PAPER_TRIGGERS = {
     "etsc/ClusterContainment-v0": ClusterContainmentTrigger,
     "etsc/ClusterContainmentCentral-v0": ClusterContainmentTrigger,
     "etsc/InnerFormation-v0": InnerFormationTrigger,
+    "etsc/AsteroidOrbitKeeping-v0": AsteroidOrbitKeepingTrigger,
 }
 """Environment id → the paper's trigger policy class."""
