@@ -31,6 +31,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--json", metavar="PATH|-", help="write the comparison as JSON")
     parser.add_argument("--plot", metavar="DIR", help="write the papers' figure counterparts")
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit with status 1 if any claim of a paper is not reproduced",
+    )
     args = parser.parse_args(argv)
     papers = args.paper or sorted(REPRODUCTIONS)
     results = []
@@ -44,7 +49,12 @@ def main(argv: list[str] | None = None) -> int:
             print()
     if args.json:
         write_json({"reproductions": results}, args.json)
-    return 0 if all(item["holds"] for r in results for item in r.get("claims", [])) else 1
+    failing = {r["paper"]: sum(not item["holds"] for item in r.get("claims", [])) for r in results}
+    failing = {paper: count for paper, count in failing.items() if count}
+    if args.json != "-":
+        summary = ", ".join(f"paper {p}: {n}" for p, n in failing.items()) or "none"
+        print(f"Claims not reproduced: {summary} (docs/fidelity.md explains each)")
+    return 1 if args.strict and failing else 0
 
 
 if __name__ == "__main__":
