@@ -20,10 +20,9 @@ import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from tqdm import tqdm
 
-from baselines.cli import make_policy
-from baselines.episodes import EpisodeTrace, run_episode
+from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row
+from baselines.reproductions.report import Scenario, claim, metric_row, run_scenario
 from baselines.triggers.asteroid import PAPER_ALPHA
 
 PAPER = "003"
@@ -82,15 +81,6 @@ TABLES = {
         for scenario in (DEFAULT, *SMALL_ALPHA)
     ],
 }
-
-
-def run_scenario(scenario: Scenario, sample: bool) -> tuple[dict[str, Any], EpisodeTrace]:
-    """One episode of ``scenario`` (seed 0, the environment's defaults otherwise)."""
-    env = gym.make(ENV_ID, **dict(scenario.env_args))
-    policy = make_policy(scenario.policy, env, dict(scenario.policy_args), ENV_ID)
-    record, trace = run_episode(env, policy, seed=0, sample_every=SAMPLE_EVERY if sample else None)
-    env.close()
-    return record, trace
 
 
 def burst_ripple(trace: EpisodeTrace, signal: str) -> tuple[float, float]:
@@ -365,7 +355,9 @@ def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str,
     traces: dict[Scenario, EpisodeTrace] = {}
     for scenario in tqdm(SCENARIOS, desc=f"paper {PAPER}", disable=not progress, unit="run"):
         sample = scenario in FIGURE_RUNS
-        records[scenario], traces[scenario] = run_scenario(scenario, sample)
+        records[scenario], traces[scenario] = run_scenario(
+            ENV_ID, scenario, SAMPLE_EVERY if sample else None
+        )
     tables = [
         {"name": name, "rows": [metric_row(s, paper, records[s]) for s, paper in rows]}
         for name, rows in TABLES.items()

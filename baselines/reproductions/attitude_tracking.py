@@ -10,15 +10,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
 import matplotlib.pyplot as plt
 import numpy as np
 from tqdm import tqdm
 
-from baselines.cli import make_policy
-from baselines.episodes import EpisodeTrace, run_episode
+from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row
+from baselines.reproductions.report import Scenario, claim, metric_row, run_scenario
 
 PAPER = "002"
 TITLE = "Event-triggered attitude tracking for rigid spacecraft (Cai et al. 2019)"
@@ -78,15 +76,6 @@ TABLES = {
     "Table 3 - square-wave desired rate": TABLE_3,
 }
 FIGURE_RUNS = {TABLE_1[0][0], TABLE_1[2][0], TABLE_3[0][0], TABLE_3[2][0]}
-
-
-def run_scenario(scenario: Scenario, sample: bool) -> tuple[dict[str, Any], EpisodeTrace]:
-    """One episode of ``scenario`` with the environment's paper defaults."""
-    env = gym.make(ENV_ID, **dict(scenario.env_args))
-    policy = make_policy(scenario.policy, env, dict(scenario.policy_args), ENV_ID)
-    record, trace = run_episode(env, policy, seed=0, sample_every=SAMPLE_EVERY if sample else None)
-    env.close()
-    return record, trace
 
 
 def _claims(records: dict[Scenario, dict[str, Any]]) -> list[dict]:
@@ -221,7 +210,9 @@ def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str,
     traces: dict[Scenario, EpisodeTrace] = {}
     for scenario in tqdm(scenarios, desc=f"paper {PAPER}", disable=not progress, unit="run"):
         sample = plot_dir is not None and scenario in FIGURE_RUNS
-        records[scenario], traces[scenario] = run_scenario(scenario, sample)
+        records[scenario], traces[scenario] = run_scenario(
+            ENV_ID, scenario, SAMPLE_EVERY if sample else None
+        )
     tables = [
         {"name": name, "rows": [metric_row(s, paper, records[s]) for s, paper in rows]}
         for name, rows in TABLES.items()

@@ -12,15 +12,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
 import matplotlib.pyplot as plt
 import numpy as np
 from tqdm import tqdm
 
-from baselines.cli import make_policy
-from baselines.episodes import EpisodeTrace, run_episode
+from baselines.episodes import EpisodeTrace
 from baselines.plotting import save
-from baselines.reproductions.report import Scenario, claim, metric_row
+from baselines.reproductions.report import Scenario, claim, metric_row, run_scenario
 from baselines.triggers.inner_formation import AXES, default_thresholds
 
 PAPER = "004"
@@ -43,15 +41,6 @@ EVENT_FINE = _event_triggered(0.5, "event-triggered, Pi/2")
 EVENT_COARSE = _event_triggered(2.0, "event-triggered, 2 Pi")
 SCENARIOS = (CONTINUOUS, EVENT, EVENT_FINE, EVENT_COARSE)
 FIGURE_RUNS = (CONTINUOUS, EVENT)
-
-
-def run_scenario(scenario: Scenario, sample: bool) -> tuple[dict[str, Any], EpisodeTrace]:
-    """One episode of ``scenario`` with the environment's defaults."""
-    env = gym.make(ENV_ID, **dict(scenario.env_args))
-    policy = make_policy(scenario.policy, env, dict(scenario.policy_args), ENV_ID)
-    record, trace = run_episode(env, policy, seed=0, sample_every=SAMPLE_EVERY if sample else None)
-    env.close()
-    return record, trace
 
 
 def _bound_rows(scenario: Scenario, record: dict[str, Any]) -> list[dict]:
@@ -85,18 +74,26 @@ def _event_rates(trace: EpisodeTrace, horizon_s: float) -> tuple[float, float]:
     return early, late
 
 
+ERROR_BOUND_KEYS = (
+    ("pos_est_err_m", "pos_est_m"),
+    ("vel_est_err_mps", "vel_est_mps"),
+    ("dist_est_err_mps2", "dist_est_mps2"),
+)
+
+
+def _errors_within(errors_of: dict[str, Any], bounds_of: dict[str, Any]) -> bool:
+    """Whether every steady error of one run lies inside the (8)-(10) bounds of another."""
+    return all(
+        errors_of[f"ss_{error}_per_axis"][axis] <= bounds_of[f"bound_{bound}_per_axis"][axis]
+        for error, bound in ERROR_BOUND_KEYS
+        for axis in range(3)
+    )
+
+
 def _claims(records: dict[Scenario, dict], traces: dict[Scenario, EpisodeTrace]) -> list[dict]:
     event, continuous = records[EVENT], records[CONTINUOUS]
     found = []
-    inside = all(
-        event[f"ss_{kind}_per_axis"][axis] <= event[f"bound_{bound}_per_axis"][axis]
-        for kind, bound in (
-            ("pos_est_err_m", "pos_est_m"),
-            ("vel_est_err_mps", "vel_est_mps"),
-            ("dist_est_err_mps2", "dist_est_mps2"),
-        )
-        for axis in range(3)
-    )
+    inside = _errors_within(event, event)
     found.append(
         claim(
             "Theorem 1: event-triggered steady errors inside (8)-(10)",
@@ -106,15 +103,7 @@ def _claims(records: dict[Scenario, dict], traces: dict[Scenario, EpisodeTrace])
             f"|h - phi| {event['ss_dist_est_err_mps2']:.3g} m/s^2",
         )
     )
-    keeps = all(
-        event[f"ss_{kind}_per_axis"][axis] <= continuous[f"bound_{bound}_per_axis"][axis]
-        for kind, bound in (
-            ("pos_est_err_m", "pos_est_m"),
-            ("vel_est_err_mps", "vel_est_mps"),
-            ("dist_est_err_mps2", "dist_est_mps2"),
-        )
-        for axis in range(3)
-    )
+    keeps = _errors_within(event, continuous)
     found.append(
         claim(
             "Remark 1: event-based sampling keeps the continuous ESO's bounds",
@@ -233,7 +222,8 @@ def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str,
     records: dict[Scenario, dict[str, Any]] = {}
     traces: dict[Scenario, EpisodeTrace] = {}
     for scenario in tqdm(SCENARIOS, desc=f"paper {PAPER}", disable=not progress, unit="run"):
-        records[scenario], traces[scenario] = run_scenario(scenario, scenario in FIGURE_RUNS)
+        sample_every = SAMPLE_EVERY if scenario in FIGURE_RUNS else None
+        records[scenario], traces[scenario] = run_scenario(ENV_ID, scenario, sample_every)
     empty = {
         "transmissions": None,
         "transmission_rate": None,

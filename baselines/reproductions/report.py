@@ -1,9 +1,15 @@
-"""The shape of a reproduction result, and its text rendering (paper value beside ours)."""
+"""The shape of a reproduction: its scenarios and how one runs, the result's rows and claims,
+and their text rendering (paper value beside ours)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any
+
+import gymnasium as gym
+
+from baselines.cli import make_policy
+from baselines.episodes import EpisodeTrace, run_episode
 
 
 @dataclass(frozen=True)
@@ -15,6 +21,18 @@ class Scenario:
     env_args: tuple[tuple[str, Any], ...]
     policy: str
     policy_args: tuple[tuple[str, Any], ...] = ()
+
+
+def run_scenario(
+    env_id: str, scenario: Scenario, sample_every: int | None = None
+) -> tuple[dict[str, Any], EpisodeTrace]:
+    """One episode of ``scenario`` on ``env_id`` with seed 0 (states sampled every
+    ``sample_every`` steps when given)."""
+    env = gym.make(env_id, **dict(scenario.env_args))
+    policy = make_policy(scenario.policy, env, dict(scenario.policy_args), env_id)
+    record, trace = run_episode(env, policy, seed=0, sample_every=sample_every)
+    env.close()
+    return record, trace
 
 
 def metric_row(scenario: Scenario, paper: dict[str, float | None], ours: dict[str, Any]) -> dict:

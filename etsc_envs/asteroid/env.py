@@ -9,7 +9,6 @@ decides at every decision instant whether to start a thrust burst: the thrusters
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -60,6 +59,7 @@ from etsc_envs.core.rotations import (
     quat_multiply,
     quat_to_euler321,
 )
+from etsc_envs.core.validation import apply_overrides
 
 FEATURE_NAMES = (
     "radius_m",
@@ -141,11 +141,9 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
         shape_length_unit_m: float | None = None,
         **overrides: Any,
     ) -> None:
-        params = params if params is not None else AsteroidParams()
-        unknown = set(overrides) - {field.name for field in dataclasses.fields(params)}
-        if unknown:
-            raise TypeError(f"unknown argument(s) for AsteroidOrbitKeepingEnv: {sorted(unknown)}")
-        self.params = p = dataclasses.replace(params, **overrides)
+        self.params = p = apply_overrides(
+            params if params is not None else AsteroidParams(), overrides, "AsteroidOrbitKeepingEnv"
+        )
         self.randomize = bool(randomize)
         if isinstance(decision_interval, bool) or int(decision_interval) != decision_interval:
             raise ValueError(

@@ -7,7 +7,6 @@ estimates. The agent decides at every 1-ms sampling instant whether the sensor t
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 import numpy as np
@@ -25,6 +24,7 @@ from etsc_envs.attitude_tracking.dynamics import (
 from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
 from etsc_envs.core.loop import EventTriggeredEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector
+from etsc_envs.core.validation import apply_overrides
 
 FEATURE_NAMES = (
     "e1_x", "e1_y", "e1_z",
@@ -73,11 +73,11 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
         randomize: bool = False,
         **overrides: Any,
     ) -> None:
-        params = params if params is not None else AttitudeTrackingParams()
-        unknown = set(overrides) - {field.name for field in dataclasses.fields(params)}
-        if unknown:
-            raise TypeError(f"unknown argument(s) for AttitudeTrackingEnv: {sorted(unknown)}")
-        self.params = dataclasses.replace(params, **overrides)
+        self.params = apply_overrides(
+            params if params is not None else AttitudeTrackingParams(),
+            overrides,
+            "AttitudeTrackingEnv",
+        )
         self.randomize = bool(randomize)
         low = np.full(len(FEATURE_NAMES), -np.inf)
         low[-1] = 0.0

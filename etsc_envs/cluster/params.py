@@ -14,13 +14,13 @@ text's statements about them hold (docs/fidelity.md, paper 001, readings 1-3).
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from etsc_envs.cluster.topology import adjacency_from_edges, validate_adjacency
 from etsc_envs.core.validation import (
+    apply_overrides,
     require_choice,
     require_non_negative,
     require_positive,
@@ -284,11 +284,7 @@ def replace_params(
 ) -> ClusterContainmentParams:
     """``params`` with ``overrides`` applied; a new ``scenario`` restores that scenario's arrays
     for every N/M-sized field not overridden. Unknown names raise ``TypeError``."""
-    names = {field.name for field in dataclasses.fields(params)}
-    unknown = set(overrides) - names
-    if unknown:
-        raise TypeError(f"unknown argument(s) for the cluster environments: {sorted(unknown)}")
     if "scenario" in overrides and overrides["scenario"] != params.scenario:
         reset = dict.fromkeys((*_scenario_defaults("paper"), "inertia_uncertainty"))
         overrides = {**reset, **overrides}
-    return dataclasses.replace(params, **overrides)
+    return apply_overrides(params, overrides, "the cluster environments")

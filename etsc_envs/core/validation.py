@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 
@@ -70,3 +72,14 @@ def require_spd_matrix(name: str, value: Iterable[Iterable[float]]) -> np.ndarra
             f"{name} must be positive definite, got eigenvalues {np.linalg.eigvalsh(matrix)}"
         )
     return matrix
+
+
+def apply_overrides(params: Any, overrides: dict[str, Any], owner: str) -> Any:
+    """``params`` (a frozen dataclass) with ``overrides`` applied field by field, validated again.
+
+    Raises ``TypeError`` naming ``owner`` and the unknown keyword(s) if an override is not a field.
+    """
+    unknown = set(overrides) - {field.name for field in dataclasses.fields(params)}
+    if unknown:
+        raise TypeError(f"unknown argument(s) for {owner}: {sorted(unknown)}")
+    return dataclasses.replace(params, **overrides)

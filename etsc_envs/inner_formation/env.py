@@ -8,12 +8,12 @@ every sampling instant, per axis, whether the sensor transmits (``MultiBinary(3)
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 import numpy as np
 
 from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.validation import apply_overrides
 from etsc_envs.inner_formation.closed_loop import closed_loop_step, sensor_features
 from etsc_envs.inner_formation.controller import ObserverFeedback
 from etsc_envs.inner_formation.design import estimation_bounds, zeno_bound_s
@@ -66,11 +66,9 @@ class InnerFormationEnv(EventTriggeredEnv):
         randomize: bool = False,
         **overrides: Any,
     ) -> None:
-        params = params if params is not None else InnerFormationParams()
-        unknown = set(overrides) - {field.name for field in dataclasses.fields(params)}
-        if unknown:
-            raise TypeError(f"unknown argument(s) for InnerFormationEnv: {sorted(unknown)}")
-        self.params = dataclasses.replace(params, **overrides)
+        self.params = apply_overrides(
+            params if params is not None else InnerFormationParams(), overrides, "InnerFormationEnv"
+        )
         self.randomize = bool(randomize)
         p = self.params
         # |r| stays inside the cavity (leaving it ends the episode), so |r - r(t_k)| < 2 R.

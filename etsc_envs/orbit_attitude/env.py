@@ -9,7 +9,6 @@ transmits the current Γ_cout; the paper's rule is eq. (21).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Any
 
@@ -17,6 +16,7 @@ import numpy as np
 
 from etsc_envs.core.loop import EventTriggeredEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector, se3_exp
+from etsc_envs.core.validation import apply_overrides
 from etsc_envs.orbit_attitude.closed_loop import (
     N_CONTROLLER_STATE,
     N_DIAGNOSTICS,
@@ -204,11 +204,11 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         randomize: bool = False,
         **overrides: Any,
     ) -> None:
-        params = params if params is not None else OrbitAttitudeParams()
-        unknown = set(overrides) - {field.name for field in dataclasses.fields(params)}
-        if unknown:
-            raise TypeError(f"unknown argument(s) for OrbitAttitudeTrackingEnv: {sorted(unknown)}")
-        self.params = dataclasses.replace(params, **overrides)
+        self.params = apply_overrides(
+            params if params is not None else OrbitAttitudeParams(),
+            overrides,
+            "OrbitAttitudeTrackingEnv",
+        )
         if not isinstance(randomize, bool | np.bool_):
             raise ValueError(f"randomize must be True or False, got {randomize!r}")
         self.randomize = bool(randomize)
