@@ -35,6 +35,18 @@ class EpisodeTrace:
         return np.array([sample[name] for sample in self.samples])
 
 
+def _episode_bar(unwrapped: Any, progress: bool, description: str) -> tqdm:
+    """A progress bar over one episode's sampling instants (hidden unless ``progress``)."""
+    return tqdm(
+        total=getattr(unwrapped, "n_steps", None),
+        disable=not progress,
+        desc=description,
+        unit="step",
+        leave=False,
+        mininterval=0.5,
+    )
+
+
 def run_episode(
     env: gym.Env,
     policy: Any,
@@ -59,14 +71,7 @@ def run_episode(
     obs, _ = env.reset(seed=seed)
     state, episode_start = None, np.ones(1, dtype=bool)
     total_return, steps = 0.0, 0
-    bar = tqdm(
-        total=getattr(unwrapped, "n_steps", None),
-        disable=not progress,
-        desc=description,
-        unit="step",
-        leave=False,
-        mininterval=0.5,
-    )
+    bar = _episode_bar(unwrapped, progress, description)
     started = time.perf_counter()
     if sampler is not None:
         trace.samples.append(sampler())
@@ -127,14 +132,7 @@ def run_parallel_episode(
     state, episode_start = None, np.ones(len(names), dtype=bool)
     returns = np.zeros(len(names))
     steps = 0
-    bar = tqdm(
-        total=getattr(unwrapped, "n_steps", None),
-        disable=not progress,
-        desc=description,
-        unit="step",
-        leave=False,
-        mininterval=0.5,
-    )
+    bar = _episode_bar(unwrapped, progress, description)
     started = time.perf_counter()
     if sampler is not None:
         trace.samples.append(sampler())
