@@ -45,22 +45,14 @@ from etsc_envs.asteroid.dynamics import (
 )
 from etsc_envs.asteroid.gravity import GRAVITATIONAL_CONSTANT
 from etsc_envs.asteroid.shape import itokawa_shape, write_obj
+from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import attitude_matrix, quat_from_rotation_vector
 
 ENV_ID = "etsc/AsteroidOrbitKeeping-v0"
 STEP_S = 0.25
 GM = GRAVITATIONAL_CONSTANT * 3.58e10
 BURST_STEPS = 200  # 50 s at 0.25 s
-COMMON_METRIC_KEYS = {
-    "steps",
-    "sim_time_s",
-    "mean_cost",
-    "transmissions",
-    "transmission_rate",
-    "mean_interevent_s",
-    "min_interevent_s",
-    "failure",
-}
+COMMON_METRIC_KEYS = set(COMMON_EPISODE_KEYS)
 PAPER_METRIC_KEYS = {
     "min_radius_m",
     "max_radius_m",

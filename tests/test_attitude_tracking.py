@@ -34,21 +34,13 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from baselines.triggers import AttitudeTrackingTrigger
+from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 PERIOD_S = 0.001
 INITIAL_ATTITUDE_ERROR = 0.4690  # |q_ev(0)| of the paper's q(0) = (0.3, -0.2, -0.3, 0.8832)
 
-COMMON_METRIC_KEYS = {
-    "steps",
-    "sim_time_s",
-    "mean_cost",
-    "transmissions",
-    "transmission_rate",
-    "mean_interevent_s",
-    "min_interevent_s",
-    "failure",
-}
+COMMON_METRIC_KEYS = set(COMMON_EPISODE_KEYS)
 PAPER_METRIC_KEYS = {"E_v", "E_q", "T_A_ms", "E_c", "mean_input_norm"}
 STEP_INFO_KEYS = {"transmitted", "transmissions", "time_s", "cost"}
 

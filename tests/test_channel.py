@@ -17,7 +17,11 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from etsc_envs.core.channel import HeldChannel
-from etsc_envs.core.metrics import communication_metrics, interevent_summary
+from etsc_envs.core.metrics import (
+    COMMON_EPISODE_KEYS,
+    communication_metrics,
+    interevent_summary,
+)
 
 METRIC_KEYS = {
     "steps",
@@ -107,6 +111,7 @@ def test_communication_metrics_on_hand_computed_schedule():
     metrics = communication_metrics(channel, steps, steps * dt, cost_sum=5.0)
 
     assert set(metrics) == METRIC_KEYS
+    assert set(COMMON_EPISODE_KEYS) == METRIC_KEYS | {"failure"}  # the loop adds "failure"
     assert metrics["steps"] == 10
     assert_allclose(metrics["sim_time_s"], 1.0)
     assert_allclose(metrics["mean_cost"], 0.5)

@@ -64,6 +64,7 @@ from etsc_envs.cluster.topology import (
 )
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
+from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import quat_kinematics, quat_to_mrp
 
 PARALLEL_ID = "etsc/ClusterContainment-v0"
@@ -71,15 +72,7 @@ CENTRAL_ID = "etsc/ClusterContainmentCentral-v0"
 PERIOD_S = 0.01
 N_PAPER = 6
 AGENTS = [f"follower_{i}" for i in range(N_PAPER)]
-COMMON_METRIC_KEYS = {
-    "steps",
-    "sim_time_s",
-    "mean_cost",
-    "transmissions",
-    "transmission_rate",
-    "mean_interevent_s",
-    "min_interevent_s",
-    "failure",
+COMMON_METRIC_KEYS = set(COMMON_EPISODE_KEYS) | {
     "converge_time_s",
     "omega_converge_time_s",
     "final_containment_err",

@@ -37,6 +37,7 @@ import etsc_envs  # noqa: F401  (registers the ids)
 from baselines.policies import AlwaysPolicy
 from baselines.triggers import OrbitAttitudeTrigger
 from etsc_envs.core.integration import make_rk4_step
+from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import se3_exp, se3_log
 from etsc_envs.orbit_attitude.closed_loop import integrate_plant
 from etsc_envs.orbit_attitude.controller import known_dynamics
@@ -66,16 +67,7 @@ NOMINAL = {
     "thruster_bias_ratio": 0.0,
     "disturbances": False,
 }
-COMMON_METRIC_KEYS = {
-    "steps",
-    "sim_time_s",
-    "mean_cost",
-    "transmissions",
-    "transmission_rate",
-    "mean_interevent_s",
-    "min_interevent_s",
-    "failure",
-}
+COMMON_METRIC_KEYS = set(COMMON_EPISODE_KEYS)
 PAPER_METRIC_KEYS = {
     "ss_att_err_deg",
     "ss_angvel_err_degps",

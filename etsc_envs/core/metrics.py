@@ -6,6 +6,19 @@ import numpy as np
 
 from etsc_envs.core.channel import HeldChannel
 
+COMMON_EPISODE_KEYS = (
+    "steps",
+    "sim_time_s",
+    "mean_cost",
+    "transmissions",
+    "transmission_rate",
+    "mean_interevent_s",
+    "min_interevent_s",
+    "failure",
+)
+"""Keys every environment's ``episode_metrics`` carries (the design page's common record;
+``failure`` is added by the step loop, the paper's own metrics come beside them)."""
+
 
 def interevent_summary(intervals_s: list[float]) -> tuple[float | None, float | None]:
     """Mean and minimum of inter-event times (``None`` when fewer than two transmissions)."""
