@@ -18,11 +18,10 @@ import gymnasium as gym
 import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-from tqdm import tqdm
 
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row, run_scenario
+from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
 from baselines.triggers.asteroid import PAPER_ALPHA
 
 PAPER = "003"
@@ -351,13 +350,9 @@ def _figures(records: dict, traces: dict, plot_dir: Path) -> list[str]:
 
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run every scenario once and compare with section 4 of the paper."""
-    records: dict[Scenario, dict[str, Any]] = {}
-    traces: dict[Scenario, EpisodeTrace] = {}
-    for scenario in tqdm(SCENARIOS, desc=f"paper {PAPER}", disable=not progress, unit="run"):
-        sample = scenario in FIGURE_RUNS
-        records[scenario], traces[scenario] = run_scenario(
-            ENV_ID, scenario, SAMPLE_EVERY if sample else None
-        )
+    records, traces = run_scenarios(
+        ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}", progress
+    )
     tables = [
         {"name": name, "rows": [metric_row(s, paper, records[s]) for s, paper in rows]}
         for name, rows in TABLES.items()

@@ -12,11 +12,10 @@ from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
-from tqdm import tqdm
 
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row, run_scenario
+from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
 
 PAPER = "002"
 TITLE = "Event-triggered attitude tracking for rigid spacecraft (Cai et al. 2019)"
@@ -206,13 +205,10 @@ def _figures(traces: dict[Scenario, EpisodeTrace], plot_dir: Path) -> list[str]:
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run every scenario of Tables 1-3 once and compare with the paper's numbers."""
     scenarios = list(dict.fromkeys(row[0] for rows in TABLES.values() for row in rows))
-    records: dict[Scenario, dict[str, Any]] = {}
-    traces: dict[Scenario, EpisodeTrace] = {}
-    for scenario in tqdm(scenarios, desc=f"paper {PAPER}", disable=not progress, unit="run"):
-        sample = plot_dir is not None and scenario in FIGURE_RUNS
-        records[scenario], traces[scenario] = run_scenario(
-            ENV_ID, scenario, SAMPLE_EVERY if sample else None
-        )
+    sampled = FIGURE_RUNS if plot_dir is not None else ()
+    records, traces = run_scenarios(
+        ENV_ID, scenarios, sampled, SAMPLE_EVERY, f"paper {PAPER}", progress
+    )
     tables = [
         {"name": name, "rows": [metric_row(s, paper, records[s]) for s, paper in rows]}
         for name, rows in TABLES.items()

@@ -14,11 +14,10 @@ from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
-from tqdm import tqdm
 
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import save
-from baselines.reproductions.report import Scenario, claim, metric_row, run_scenario
+from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
 from baselines.triggers.inner_formation import AXES, default_thresholds
 
 PAPER = "004"
@@ -219,11 +218,9 @@ def _figures(traces: dict[Scenario, EpisodeTrace], plot_dir: Path) -> list[str]:
 
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run the four scenarios and compare with Theorem 1, Theorem 3 and section 4's claims."""
-    records: dict[Scenario, dict[str, Any]] = {}
-    traces: dict[Scenario, EpisodeTrace] = {}
-    for scenario in tqdm(SCENARIOS, desc=f"paper {PAPER}", disable=not progress, unit="run"):
-        sample_every = SAMPLE_EVERY if scenario in FIGURE_RUNS else None
-        records[scenario], traces[scenario] = run_scenario(ENV_ID, scenario, sample_every)
+    records, traces = run_scenarios(
+        ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}", progress
+    )
     empty = {
         "transmissions": None,
         "transmission_rate": None,

@@ -3,10 +3,12 @@ and their text rendering (paper value beside ours)."""
 
 from __future__ import annotations
 
+from collections.abc import Container, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
 import gymnasium as gym
+from tqdm import tqdm
 
 from baselines.cli import make_policy
 from baselines.episodes import EpisodeTrace, run_episode
@@ -33,6 +35,24 @@ def run_scenario(
     record, trace = run_episode(env, policy, seed=0, sample_every=sample_every)
     env.close()
     return record, trace
+
+
+def run_scenarios(
+    env_id: str,
+    scenarios: Iterable[Scenario],
+    sampled: Container[Scenario],
+    sample_every: int,
+    description: str,
+    progress: bool = False,
+) -> tuple[dict[Scenario, dict[str, Any]], dict[Scenario, EpisodeTrace]]:
+    """Run each scenario once (those in ``sampled`` storing states every ``sample_every``
+    steps) and return the episode records and traces by scenario."""
+    records: dict[Scenario, dict[str, Any]] = {}
+    traces: dict[Scenario, EpisodeTrace] = {}
+    for scenario in tqdm(list(scenarios), desc=description, disable=not progress, unit="run"):
+        every = sample_every if scenario in sampled else None
+        records[scenario], traces[scenario] = run_scenario(env_id, scenario, every)
+    return records, traces
 
 
 def metric_row(scenario: Scenario, paper: dict[str, float | None], ours: dict[str, Any]) -> dict:
