@@ -3,9 +3,14 @@
 Section 4 runs observer and controller "by difference approximation with t_s = 0.001 s": the
 ET-ESO eq. (16) is advanced by a forward-Euler step and the control u(t_k) of eq. (24) is held
 over the period; the plant of eq. (1) and the desired motion of eq. (2) are integrated with RK4.
+
+The environment keeps one loop in a flat state row (layout below) and reaches it through the
+kernels of :data:`KERNELS` (see :mod:`etsc_envs.core.compiled_loop`).
 """
 
 from __future__ import annotations
+
+from collections import namedtuple
 
 import numpy as np
 
@@ -21,10 +26,30 @@ from etsc_envs.attitude_tracking.dynamics import (
     plant_derivative,
     tracking_error,
 )
+from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
 
 N_FEATURES = 13
+
+PLANT = slice(0, 11)  # y = [q, ω, q_d] of the plant and the desired motion
+OBSERVER = slice(11, 17)  # [x̂_1, x̂_2] of the ET-ESO, eq. (16)
+MEASUREMENT = slice(17, 20)  # x_1 = z = ω_e + K q_ev at the current instant, eq. (8)
+RATE_ERROR = slice(20, 23)  # ω_e of eq. (4)
+TORQUE = slice(23, 26)  # u of eq. (24) over the last period
+FEATURES = slice(26, 39)  # the sensor's features, see sensor_features
+ACCUMULATED = slice(39, 43)  # running sums: eq. (50) rate and attitude terms, eq. (52), Σ|u_i|
+INERTIA_PHASE = slice(43, 46)  # phases of ΔJ(t), drawn per episode when randomized
+DISTURBANCE_PHASE = slice(46, 49)  # phases of d(t)
+STATE_WIDTH = 49
+"""Layout of the state row."""
+
+NON_FINITE, OMEGA_DIVERGED, RATE_ERROR_DIVERGED = 1, 2, 3
+"""Failure codes of :func:`loop_failure`."""
+
+LoopConstants = namedtuple("LoopConstants", ["model", "gains", "max_rate"])
+"""What every episode shares: the plant model (its phases are taken from the state row), the
+observer and controller gains, and the divergence bound on |ω| and |ω_e| (rad/s)."""
 
 integrate_plant = make_rk4_step(plant_derivative)
 
@@ -98,3 +123,97 @@ def closed_loop_step(
         attitude_error,
         energy_increment,
     )
+
+
+@jit
+def episode_model(state: np.ndarray, constants: LoopConstants) -> PlantModel:
+    """The plant model of the episode: the shared one with the state row's phases."""
+    shared = constants.model
+    return PlantModel(
+        shared.nominal_inertia,
+        shared.inertia_amplitude,
+        shared.inertia_frequency,
+        state[INERTIA_PHASE],
+        shared.disturbance_amplitude,
+        shared.disturbance_frequency,
+        state[DISTURBANCE_PHASE],
+        shared.reference_kind,
+        shared.reference_amplitude,
+        shared.reference_frequency,
+        shared.reference_switch_period,
+    )
+
+
+@jit
+def channel_values(state: np.ndarray, constants: LoopConstants, time_s: float) -> np.ndarray:
+    """The sensor's transmission: the current measurement x_1(t_k)."""
+    return state[MEASUREMENT].copy().reshape(1, 3)
+
+
+@jit
+def advance_loop(
+    state: np.ndarray,
+    constants: LoopConstants,
+    step_index: int,
+    h: float,
+    held: np.ndarray,
+    sent: np.ndarray,
+    channel_costs: np.ndarray,
+) -> None:
+    """One sampling period in the state row; the cost is the eq. (50) integrands' sum."""
+    model = episode_model(state, constants)
+    (
+        plant,
+        observer,
+        torque,
+        measurement,
+        rate_error_vector,
+        features,
+        rate_error,
+        attitude_error,
+        energy_increment,
+    ) = closed_loop_step(
+        step_index * h, h, state[PLANT], state[OBSERVER], held[0], model, constants.gains
+    )
+    state[PLANT] = plant
+    state[OBSERVER] = observer
+    state[TORQUE] = torque
+    state[MEASUREMENT] = measurement
+    state[RATE_ERROR] = rate_error_vector
+    state[FEATURES] = features
+    accumulated = state[ACCUMULATED]
+    accumulated[0] += rate_error
+    accumulated[1] += attitude_error
+    accumulated[2] += energy_increment
+    accumulated[3] += np.abs(torque).sum()
+    channel_costs[0] = rate_error + attitude_error
+
+
+@jit
+def loop_failure(state: np.ndarray, constants: LoopConstants) -> int:
+    """A non-finite state, or |ω| or |ω_e| beyond ``max_rate``."""
+    if not np.isfinite(state[PLANT].sum() + state[FEATURES].sum()):
+        return NON_FINITE
+    omega = state[4:7]
+    if np.sqrt(omega @ omega) > constants.max_rate:
+        return OMEGA_DIVERGED
+    omega_e = state[RATE_ERROR]
+    if np.sqrt(omega_e @ omega_e) > constants.max_rate:
+        return RATE_ERROR_DIVERGED
+    return 0
+
+
+@jit
+def loop_features(state: np.ndarray, constants: LoopConstants, out: np.ndarray) -> None:
+    """The observation's features: the sensor's, as computed by the last step."""
+    out[:] = state[FEATURES]
+
+
+KERNELS = ProblemKernels(
+    channel_values=channel_values,
+    accepts=always_accepts,
+    advance=advance_loop,
+    failure=loop_failure,
+    features=loop_features,
+)
+"""The compiled loop of paper 002."""

@@ -11,7 +11,24 @@ from typing import Any
 
 import numpy as np
 
-from etsc_envs.attitude_tracking.closed_loop import closed_loop_step, sensor_features
+from etsc_envs.attitude_tracking.closed_loop import (
+    ACCUMULATED,
+    DISTURBANCE_PHASE,
+    FEATURES,
+    INERTIA_PHASE,
+    KERNELS,
+    MEASUREMENT,
+    NON_FINITE,
+    OBSERVER,
+    OMEGA_DIVERGED,
+    PLANT,
+    RATE_ERROR,
+    STATE_WIDTH,
+    TORQUE,
+    LoopConstants,
+    episode_model,
+    sensor_features,
+)
 from etsc_envs.attitude_tracking.controller import LoopGains
 from etsc_envs.attitude_tracking.dynamics import (
     SINUSOID,
@@ -22,7 +39,7 @@ from etsc_envs.attitude_tracking.dynamics import (
     tracking_error,
 )
 from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
-from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector
 from etsc_envs.core.validation import apply_overrides
 
@@ -64,6 +81,8 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
     named in :data:`FEATURE_NAMES` followed by ``time_since_transmission_s``.
     """
 
+    kernels = KERNELS
+
     def __init__(
         self,
         params: AttitudeTrackingParams | None = None,
@@ -79,20 +98,6 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             "AttitudeTrackingEnv",
         )
         self.randomize = bool(randomize)
-        low = np.full(len(FEATURE_NAMES), -np.inf)
-        low[-1] = 0.0
-        super().__init__(
-            feature_names=FEATURE_NAMES,
-            feature_low=low,
-            feature_high=np.full(len(FEATURE_NAMES), np.inf),
-            n_channels=1,
-            channel_width=3,
-            sampling_period_s=self.params.sampling_period_s,
-            horizon_s=self.params.horizon_s,
-            transmission_penalty=transmission_penalty,
-            cost_scale=cost_scale,
-            failure_cost=self.params.max_rate_rad_s,
-        )
         p = self.params
         self.gains = LoopGains(
             attitude_gain=np.array(p.attitude_gain, dtype=float),
@@ -102,41 +107,16 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             c=float(p.observer_c),
             nominal_inertia=np.array(p.nominal_inertia, dtype=float),
         )
-        self.plant_state = np.zeros(11)
-        self.observer_state = np.zeros(6)
-        self.measurement = np.zeros(3)
-        self.rate_error_vector = np.zeros(3)
-        self.torque = np.zeros(3)
-        self._features_now = np.zeros(len(FEATURE_NAMES))
-        self._accumulated = np.zeros(4)
-
-    # ----------------------------------------------------------------- hooks
-    def _reset_problem(self, options: dict[str, Any] | None) -> None:
-        p = self.params
-        rng = self.np_random
-        if self.randomize:
-            axis = rng.normal(size=3)
-            axis /= np.linalg.norm(axis)
-            angle = rng.uniform(0.0, RANDOM_ATTITUDE_MAX_ANGLE_RAD)
-            attitude = quat_from_rotation_vector(angle * axis)
-            rate = rng.uniform(-RANDOM_RATE_MAX_RAD_S, RANDOM_RATE_MAX_RAD_S, size=3)
-            inertia_phase = rng.uniform(0.0, 2.0 * np.pi, size=3)
-            disturbance_phase = rng.uniform(0.0, 2.0 * np.pi, size=3)
-        else:
-            attitude = np.array(p.initial_attitude) / np.linalg.norm(p.initial_attitude)
-            rate = np.array(p.initial_rate, dtype=float)
-            inertia_phase = np.zeros(3)
-            disturbance_phase = np.zeros(3)
         scale = 1.0 if p.uncertainties else 0.0
         sinusoid = p.reference == "sinusoid"
-        self.model = PlantModel(
+        shared_model = PlantModel(
             nominal_inertia=np.array(p.nominal_inertia, dtype=float),
             inertia_amplitude=scale * np.array(p.inertia_variation_amplitude, dtype=float),
             inertia_frequency=np.array(p.inertia_variation_frequency, dtype=float),
-            inertia_phase=inertia_phase,
+            inertia_phase=np.zeros(3),
             disturbance_amplitude=scale * np.array(p.disturbance_amplitude, dtype=float),
             disturbance_frequency=np.array(p.disturbance_frequency, dtype=float),
-            disturbance_phase=disturbance_phase,
+            disturbance_phase=np.zeros(3),
             reference_kind=SINUSOID if sinusoid else SQUARE,
             reference_amplitude=(
                 np.full(3, p.sinusoid_amplitude)
@@ -146,98 +126,105 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             reference_frequency=np.array(p.sinusoid_frequency, dtype=float),
             reference_switch_period=float(p.square_switch_period_s),
         )
+        low = np.full(len(FEATURE_NAMES), -np.inf)
+        low[-1] = 0.0
+        super().__init__(
+            feature_names=FEATURE_NAMES,
+            feature_low=low,
+            feature_high=np.full(len(FEATURE_NAMES), np.inf),
+            n_channels=1,
+            channel_width=3,
+            state_width=STATE_WIDTH,
+            constants=LoopConstants(
+                model=shared_model, gains=self.gains, max_rate=float(p.max_rate_rad_s)
+            ),
+            sampling_period_s=p.sampling_period_s,
+            horizon_s=p.horizon_s,
+            transmission_penalty=transmission_penalty,
+            cost_scale=cost_scale,
+            failure_cost=p.max_rate_rad_s,
+        )
+
+    @property
+    def model(self) -> PlantModel:
+        """The plant model of the current episode (with its disturbance phases)."""
+        return episode_model(self.state, self.constants)
+
+    # ----------------------------------------------------------------- hooks
+    def _reset_problem(self, options: dict[str, Any] | None) -> None:
+        p = self.params
+        rng = self.np_random
+        state = self.state
+        if self.randomize:
+            axis = rng.normal(size=3)
+            axis /= np.linalg.norm(axis)
+            angle = rng.uniform(0.0, RANDOM_ATTITUDE_MAX_ANGLE_RAD)
+            attitude = quat_from_rotation_vector(angle * axis)
+            rate = rng.uniform(-RANDOM_RATE_MAX_RAD_S, RANDOM_RATE_MAX_RAD_S, size=3)
+            state[INERTIA_PHASE] = rng.uniform(0.0, 2.0 * np.pi, size=3)
+            state[DISTURBANCE_PHASE] = rng.uniform(0.0, 2.0 * np.pi, size=3)
+        else:
+            attitude = np.array(p.initial_attitude) / np.linalg.norm(p.initial_attitude)
+            rate = np.array(p.initial_rate, dtype=float)
         desired = np.array(p.initial_desired_attitude) / np.linalg.norm(p.initial_desired_attitude)
-        self.plant_state = np.concatenate([attitude, rate, desired])
-        self.torque = np.zeros(3)
-        _, self.rate_error_vector, self.measurement, _ = tracking_error(
-            0.0, self.plant_state, self.gains.attitude_gain, self.model
+        state[PLANT] = np.concatenate([attitude, rate, desired])
+        _, state[RATE_ERROR], state[MEASUREMENT], _ = tracking_error(
+            0.0, state[PLANT], self.gains.attitude_gain, self.model
         )
-        self.observer_state = np.zeros(6)
         if p.observer_start == "first_measurement":
-            self.observer_state[0:3] = self.measurement
-        self._features_now = sensor_features(
-            self.measurement, self.observer_state, self.measurement, self.gains
+            state[OBSERVER][0:3] = state[MEASUREMENT]
+        state[FEATURES] = sensor_features(
+            state[MEASUREMENT], state[OBSERVER], state[MEASUREMENT], self.gains
         )
-        # Running sums of eq. (50)-(52) terms: rate error, attitude error, energy, ‖u‖₁ (Table 2).
-        self._accumulated = np.zeros(4)
 
-    def _channel_values(self) -> np.ndarray:
-        return self.measurement
-
-    def _advance(self) -> float:
-        (
-            self.plant_state,
-            self.observer_state,
-            self.torque,
-            self.measurement,
-            self.rate_error_vector,
-            self._features_now,
-            rate_error,
-            attitude_error,
-            energy_increment,
-        ) = closed_loop_step(
-            self.time_s,
-            self.sampling_period_s,
-            self.plant_state,
-            self.observer_state,
-            self.channel.held[0],
-            self.model,
-            self.gains,
-        )
-        self._accumulated += (
-            rate_error,
-            attitude_error,
-            energy_increment,
-            np.abs(self.torque).sum(),
-        )
-        return rate_error + attitude_error
-
-    def _failure(self) -> str | None:
-        if not np.isfinite(self.plant_state.sum() + self._features_now.sum()):
+    def _failure_message(self, code: int) -> str:
+        if code == NON_FINITE:
             return "non-finite state"
+        name, rate = (
+            ("omega", self.state[4:7])
+            if code == OMEGA_DIVERGED
+            else (
+                "omega_e",
+                self.state[RATE_ERROR],
+            )
+        )
         limit = self.params.max_rate_rad_s
-        for name, rate in (("omega", self.plant_state[4:7]), ("omega_e", self.rate_error_vector)):
-            norm = float(np.sqrt(rate @ rate))
-            if norm > limit:
-                return f"diverged: |{name}| = {norm:.3g} rad/s > max_rate_rad_s = {limit}"
-        return None
-
-    def _features(self) -> np.ndarray:
-        return self._features_now
+        norm = float(np.sqrt(rate @ rate))
+        return f"diverged: |{name}| = {norm:.3g} rad/s > max_rate_rad_s = {limit}"
 
     def _paper_metrics(self) -> dict[str, Any]:
         steps = max(self.step_index, 1)
-        rate_sum, attitude_sum, energy, input_norm_sum = self._accumulated
-        transmissions = int(self.channel.transmissions.sum())
+        rate_sum, attitude_sum, energy, input_norm_sum = self.state[ACCUMULATED]
+        transmissions = int(self.transmissions.sum())
         return {
-            "E_v": rate_sum / steps,
-            "E_q": attitude_sum / steps,
+            "E_v": float(rate_sum) / steps,
+            "E_q": float(attitude_sum) / steps,
             "T_A_ms": 1000.0 * self.time_s / transmissions if transmissions else None,
             "E_c": float(energy),
-            "mean_input_norm": input_norm_sum / steps,  # time mean of Σ|u_i|, N·m
+            "mean_input_norm": float(input_norm_sum) / steps,  # time mean of Σ|u_i|, N·m
         }
 
     # ----------------------------------------------------------------- diagnostics
     def state_dict(self) -> dict[str, np.ndarray]:
         """Named copies of the loop's signals at the current instant (for plots and tests)."""
         t = self.time_s
-        q_e, omega_e, z, _ = tracking_error(
-            t, self.plant_state, self.gains.attitude_gain, self.model
-        )
+        state = self.state
+        model = self.model
+        plant = state[PLANT]
+        q_e, omega_e, z, _ = tracking_error(t, plant, self.gains.attitude_gain, model)
+        torque = state[TORQUE].copy()
         return {
             "time_s": np.array(t),
-            "q": self.plant_state[0:4].copy(),
-            "omega": self.plant_state[4:7].copy(),
-            "q_d": self.plant_state[7:11].copy(),
-            "omega_d": desired_rate(t, self.model),
+            "q": plant[0:4].copy(),
+            "omega": plant[4:7].copy(),
+            "q_d": plant[7:11].copy(),
+            "omega_d": desired_rate(t, model),
             "q_e": q_e,
             "omega_e": omega_e,
             "x1": z,
-            "x1_hat": self.observer_state[0:3].copy(),
-            "x2": total_disturbance(
-                t, self.plant_state, self.torque, self.gains.attitude_gain, self.model
-            ),
-            "x2_hat": self.observer_state[3:6].copy(),
-            "xi": self.channel.held[0].copy(),
-            "u": self.torque.copy(),
+            "x1_hat": state[OBSERVER][0:3].copy(),
+            "x2": total_disturbance(t, plant, torque, self.gains.attitude_gain, model),
+            "x2_hat": state[OBSERVER][3:6].copy(),
+            "xi": self.held[0].copy(),
+            "u": torque,
         }

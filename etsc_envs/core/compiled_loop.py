@@ -1,0 +1,248 @@
+"""The compiled step loop: one sampling instant of many independent closed loops in one call.
+
+Every environment of the suite keeps the whole state of its closed loop in flat arrays with a
+leading batch axis (:class:`LoopArrays`): the channel's held values and transmission
+bookkeeping, the running cost, the observation, and one float64 row per environment holding
+the problem's own state (plant, observer, controller, running metrics, per-episode model
+parameters) in a layout the problem documents. A single environment owns a batch of one row;
+a vector environment owns ``num_envs`` rows and each of its sub-environments is bound to a view
+of one row. Both advance through the same compiled function, built once per problem by
+:func:`make_loop_step` from five compiled kernels (:class:`ProblemKernels`), so the design
+page's step semantics are written once:
+
+1. at ``t_k = k h`` every channel whose transmit bit is set and whose receiver
+   ``accepts`` it takes the current ``channel_values`` (zero-order hold);
+2. ``advance`` moves plant, observer and controller to ``t_k + h`` with the held values and
+   writes each channel's share of the step's accuracy cost;
+3. ``failure`` returns 0 or a problem-specific code; a failure ends the episode, keeps the
+   last observation, and charges ``failure_cost`` for every step it cuts from the horizon;
+4. otherwise ``features`` and the time since each channel's last transmission form the
+   observation;
+5. the reward is ``-cost/cost_scale - transmission_penalty * (channels sent)``, in total and
+   per channel (each channel pays its own cost, its own transmissions and an equal share of a
+   failure charge, so the per-channel rewards sum to the total).
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+from numba import prange
+
+from etsc_envs.core.jit import jit, parallel_jit
+
+LoopArrays = namedtuple(
+    "LoopArrays",
+    [
+        "step_index",  # (n,) int64: sampling instants completed in the episode
+        "held",  # (n, C, W): the value each channel's receiver holds
+        "last_sent_s",  # (n, C): time of the last transmission (of the reset if none)
+        "transmissions",  # (n, C) int64: transmissions in the episode
+        "interevent_sum_s",  # (n, C): sum of the times between consecutive transmissions
+        "interevent_min_s",  # (n, C): their minimum (inf while fewer than two)
+        "sent",  # (n, C) int64: 1 where the last step transmitted
+        "channel_costs",  # (n, C): each channel's accuracy cost of the last step
+        "channel_rewards",  # (n, C): each channel's reward of the last step
+        "reward",  # (n,): the last step's reward
+        "cost_sum",  # (n,): accuracy cost summed over the episode
+        "failure_code",  # (n,) int64: 0, or why the episode ended (problem-specific)
+        "observation",  # (n, F + C) float32: features, then time since each transmission
+        "state",  # (n, S): the problem's state row
+    ],
+)
+"""Every array a batch of closed loops lives in (see the module docstring)."""
+
+ProblemKernels = namedtuple(
+    "ProblemKernels", ["channel_values", "accepts", "advance", "failure", "features"]
+)
+"""The compiled functions that make a closed loop out of the generic step:
+
+* ``channel_values(state, constants, time_s) -> (C, W) array``: what each channel would send;
+* ``accepts(state, held, constants, time_s, channel) -> bool``: whether the receiver takes a
+  transmission now (use :func:`always_accepts` unless it can be busy);
+* ``advance(state, constants, step_index, h, held, sent, channel_costs) -> None``: one sampling
+  period from ``t_k = step_index * h``; updates ``state`` in place and writes ``channel_costs``;
+* ``failure(state, constants) -> int``: 0, or a positive code the env turns into a message;
+* ``features(state, constants, out) -> None``: the problem's observation components at the
+  current instant.
+
+``state`` is one row of :attr:`LoopArrays.state`; ``constants`` is the problem's immutable
+namedtuple, the same for every environment of a batch.
+"""
+
+LoopStep = namedtuple("LoopStep", ["serial", "parallel"])
+"""The batched step compiled twice: ``serial`` for a single environment and small batches,
+``parallel`` (rows spread over all cores) for large ones."""
+
+
+@jit
+def always_accepts(
+    state: np.ndarray, held: np.ndarray, constants, time_s: float, channel: int
+) -> bool:
+    """``accepts`` of a receiver that can always take a transmission."""
+    return True
+
+
+def allocate_loop_arrays(
+    n_envs: int, n_channels: int, channel_width: int, n_features: int, state_width: int
+) -> LoopArrays:
+    """Zeroed arrays for ``n_envs`` closed loops."""
+    return LoopArrays(
+        step_index=np.zeros(n_envs, dtype=np.int64),
+        held=np.zeros((n_envs, n_channels, channel_width)),
+        last_sent_s=np.zeros((n_envs, n_channels)),
+        transmissions=np.zeros((n_envs, n_channels), dtype=np.int64),
+        interevent_sum_s=np.zeros((n_envs, n_channels)),
+        interevent_min_s=np.full((n_envs, n_channels), np.inf),
+        sent=np.zeros((n_envs, n_channels), dtype=np.int64),
+        channel_costs=np.zeros((n_envs, n_channels)),
+        channel_rewards=np.zeros((n_envs, n_channels)),
+        reward=np.zeros(n_envs),
+        cost_sum=np.zeros(n_envs),
+        failure_code=np.zeros(n_envs, dtype=np.int64),
+        observation=np.zeros((n_envs, n_features + n_channels), dtype=np.float32),
+        state=np.zeros((n_envs, state_width)),
+    )
+
+
+def loop_rows(arrays: LoopArrays, start: int, stop: int) -> LoopArrays:
+    """Views of rows ``start:stop`` of every array (writes reach the batch)."""
+    return LoopArrays(*(array[start:stop] for array in arrays))
+
+
+def make_loop_step(kernels: ProblemKernels) -> LoopStep:
+    """Compile the step of the module docstring around a problem's kernels.
+
+    Both compiled functions have the signature ``step(actions, active, arrays, constants, h,
+    n_steps, cost_scale, transmission_penalty, failure_cost)``: ``actions`` is an ``(n, C)``
+    int array of transmit bits, ``active`` an ``(n,)`` bool array of the rows to advance (the
+    others are left untouched), ``arrays`` a :class:`LoopArrays` of ``n`` rows. The kernels
+    are bound at compile time rather than passed as arguments so that the machine code can be
+    cached on disk.
+    """
+    channel_values = kernels.channel_values
+    accepts = kernels.accepts
+    advance = kernels.advance
+    failure = kernels.failure
+    features = kernels.features
+
+    @jit
+    def step_row(
+        i, actions, arrays, constants, h, n_steps, cost_scale, transmission_penalty, failure_cost
+    ):
+        step_index = arrays.step_index[i]
+        time_s = step_index * h
+        state = arrays.state[i]
+        held = arrays.held[i]
+        sent = arrays.sent[i]
+        n_channels = held.shape[0]
+        values = channel_values(state, constants, time_s)
+        sent_total = 0
+        for channel in range(n_channels):
+            sent[channel] = 0
+            if actions[i, channel] != 0 and accepts(state, held, constants, time_s, channel):
+                held[channel, :] = values[channel]
+                if arrays.transmissions[i, channel] > 0:
+                    interval = time_s - arrays.last_sent_s[i, channel]
+                    arrays.interevent_sum_s[i, channel] += interval
+                    if interval < arrays.interevent_min_s[i, channel]:
+                        arrays.interevent_min_s[i, channel] = interval
+                arrays.last_sent_s[i, channel] = time_s
+                arrays.transmissions[i, channel] += 1
+                sent[channel] = 1
+                sent_total += 1
+        costs = arrays.channel_costs[i]
+        advance(state, constants, step_index, h, held, sent, costs)
+        step_index += 1
+        arrays.step_index[i] = step_index
+        code = failure(state, constants)
+        arrays.failure_code[i] = code
+        cost = costs.sum()
+        failure_charge = 0.0
+        if code != 0:
+            if not np.isfinite(cost):
+                costs[:] = 0.0
+                cost = 0.0
+            failure_charge = failure_cost * (n_steps - step_index)
+        else:
+            observation = arrays.observation[i]
+            n_features = observation.shape[0] - n_channels
+            scratch = np.empty(n_features)
+            features(state, constants, scratch)
+            observation[:n_features] = scratch
+            time_next = step_index * h
+            for channel in range(n_channels):
+                observation[n_features + channel] = time_next - arrays.last_sent_s[i, channel]
+        arrays.cost_sum[i] += cost
+        arrays.reward[i] = -(cost + failure_charge) / cost_scale - transmission_penalty * sent_total
+        share = failure_charge / n_channels
+        for channel in range(n_channels):
+            arrays.channel_rewards[i, channel] = (
+                -(costs[channel] + share) / cost_scale - transmission_penalty * sent[channel]
+            )
+
+    @jit
+    def step_serial(
+        actions,
+        active,
+        arrays,
+        constants,
+        h,
+        n_steps,
+        cost_scale,
+        transmission_penalty,
+        failure_cost,
+    ):
+        for i in range(actions.shape[0]):
+            if active[i]:
+                step_row(
+                    i,
+                    actions,
+                    arrays,
+                    constants,
+                    h,
+                    n_steps,
+                    cost_scale,
+                    transmission_penalty,
+                    failure_cost,
+                )
+
+    @parallel_jit
+    def step_parallel(
+        actions,
+        active,
+        arrays,
+        constants,
+        h,
+        n_steps,
+        cost_scale,
+        transmission_penalty,
+        failure_cost,
+    ):
+        for i in prange(actions.shape[0]):
+            if active[i]:
+                step_row(
+                    i,
+                    actions,
+                    arrays,
+                    constants,
+                    h,
+                    n_steps,
+                    cost_scale,
+                    transmission_penalty,
+                    failure_cost,
+                )
+
+    return LoopStep(serial=step_serial, parallel=step_parallel)
+
+
+def interevent_summary(
+    transmissions: np.ndarray, interevent_sum_s: np.ndarray, interevent_min_s: np.ndarray
+) -> tuple[float | None, float | None]:
+    """Mean and minimum time between consecutive transmissions of the given channels pooled
+    (``None`` when no channel transmitted twice)."""
+    intervals = int(np.maximum(np.asarray(transmissions) - 1, 0).sum())
+    if intervals == 0:
+        return None, None
+    return float(np.sum(interevent_sum_s) / intervals), float(np.min(interevent_min_s))

@@ -1,0 +1,289 @@
+"""The Gymnasium environment shared by every single-agent problem of the suite.
+
+One call to :meth:`EventTriggeredEnv.step` is one sampling instant ``t_k`` of the design page,
+run by the problem's compiled loop step (:mod:`etsc_envs.core.compiled_loop`) on a batch of
+one row: the agent's transmit bits refresh the held channel values, plant, observer and
+controller advance one sampling period, and the reward is ``-cost_k / cost_scale -
+transmission_penalty * (channels sent)``. A failure (divergence, non-finite state, collision)
+terminates the episode with ``info["failure"]`` and charges ``failure_cost`` for each step
+left to the horizon.
+
+A problem subclasses :class:`EventTriggeredEnv`, sets the class attribute ``kernels`` (its
+:class:`~etsc_envs.core.compiled_loop.ProblemKernels`) and implements three Python hooks:
+``_reset_problem`` (write the initial state row from ``self.np_random``),
+``_failure_message`` (the text of a failure code) and ``_paper_metrics`` (the paper's episode
+metrics, read from the state row). Everything a step changes lives in the loop arrays, so a
+vector environment can bind many such environments to the rows of one batch
+(:mod:`etsc_envs.core.vector_env`); Python attributes of a problem may be set by
+``_reset_problem`` but never by a step.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+
+from etsc_envs.core.compiled_loop import (
+    LoopArrays,
+    LoopStep,
+    ProblemKernels,
+    allocate_loop_arrays,
+    interevent_summary,
+    make_loop_step,
+)
+from etsc_envs.core.validation import require_non_negative, require_positive
+
+
+class EventTriggeredEnv(gym.Env):
+    """Transmit-or-hold decision at every sampling instant of a compiled closed loop.
+
+    Args:
+        feature_names: names of the problem's observation components (the observation is these
+            followed by one ``time_since_transmission_s`` entry per channel).
+        feature_low, feature_high: bounds of those components.
+        n_channels: separately triggered channels; one gives ``Discrete(2)``, more give
+            ``MultiBinary(n_channels)``.
+        channel_width: length of the value each channel carries.
+        state_width: length of the problem's state row.
+        constants: the problem's immutable parameters (a namedtuple the kernels read).
+        sampling_period_s: the sampling period (s).
+        horizon_s: the scenario's length (s); reaching it truncates the episode.
+        transmission_penalty: λ, the reward lost per transmitted channel.
+        cost_scale: divisor of the accuracy cost in the reward.
+        failure_cost: the cost charged for every step a failure cuts from the horizon, so that
+            ending an episode by diverging never pays more than staying in control.
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+    kernels: ClassVar[ProblemKernels]
+    loop_step: ClassVar[LoopStep]
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "kernels" in cls.__dict__:
+            cls.loop_step = make_loop_step(cls.kernels)
+
+    def __init__(
+        self,
+        *,
+        feature_names: tuple[str, ...],
+        feature_low: np.ndarray,
+        feature_high: np.ndarray,
+        n_channels: int,
+        channel_width: int,
+        state_width: int,
+        constants: Any,
+        sampling_period_s: float,
+        horizon_s: float,
+        transmission_penalty: float,
+        cost_scale: float,
+        failure_cost: float,
+    ) -> None:
+        self.sampling_period_s = require_positive("sampling_period_s", sampling_period_s)
+        self.horizon_s = require_positive("horizon_s", horizon_s)
+        if self.horizon_s < self.sampling_period_s:
+            raise ValueError(
+                f"horizon_s must be >= sampling_period_s ({self.sampling_period_s} s), "
+                f"got {horizon_s}"
+            )
+        self.transmission_penalty = require_non_negative(
+            "transmission_penalty", transmission_penalty
+        )
+        self.cost_scale = require_positive("cost_scale", cost_scale)
+        self.failure_cost = require_non_negative("failure_cost", failure_cost)
+        self.n_steps = round(self.horizon_s / self.sampling_period_s)
+        self.n_channels = n_channels
+        self.constants = constants
+
+        clock_names = (
+            ("time_since_transmission_s",)
+            if n_channels == 1
+            else tuple(f"time_since_transmission_s_{i}" for i in range(n_channels))
+        )
+        self.observation_names: tuple[str, ...] = tuple(feature_names) + clock_names
+        self.n_features = len(feature_names)
+        low = np.concatenate([feature_low, np.zeros(n_channels)]).astype(np.float32)
+        high = np.concatenate([feature_high, np.full(n_channels, self.horizon_s)]).astype(
+            np.float32
+        )
+        self.observation_space = gym.spaces.Box(low=low, high=high, dtype=np.float32)
+        self.action_space = (
+            gym.spaces.Discrete(2) if n_channels == 1 else gym.spaces.MultiBinary(n_channels)
+        )
+        self.loop_shape = (n_channels, channel_width, self.n_features, state_width)
+        self._actions = np.zeros((1, n_channels), dtype=np.int64)
+        self._active = np.ones(1, dtype=bool)
+        self.bind(allocate_loop_arrays(1, *self.loop_shape))
+
+    def bind(self, arrays: LoopArrays) -> None:
+        """Live in ``arrays`` (one row, typically a view into a vector environment's batch)."""
+        self.arrays = arrays
+        self.state = arrays.state[0]
+
+    # ----------------------------------------------------------------- problem hooks
+    def _reset_problem(self, options: dict[str, Any] | None) -> None:
+        raise NotImplementedError
+
+    def _failure_message(self, code: int) -> str:
+        raise NotImplementedError
+
+    def _paper_metrics(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def _initial_held(self) -> np.ndarray:
+        """The values both sides of the channel agree on at reset (by default the current ones;
+        not counted as a transmission)."""
+        return self.kernels.channel_values(self.state, self.constants, 0.0)
+
+    # ----------------------------------------------------------------- loop signals
+    @property
+    def step_index(self) -> int:
+        """Sampling instants completed in the episode."""
+        return int(self.arrays.step_index[0])
+
+    @property
+    def time_s(self) -> float:
+        """Simulated time of the current sampling instant."""
+        return self.step_index * self.sampling_period_s
+
+    @property
+    def held(self) -> np.ndarray:
+        """The value each channel's receiver holds, ``(n_channels, channel_width)``."""
+        return self.arrays.held[0]
+
+    @property
+    def transmissions(self) -> np.ndarray:
+        """Transmissions of each channel in the episode."""
+        return self.arrays.transmissions[0]
+
+    @property
+    def last_sent_s(self) -> np.ndarray:
+        """When each channel last transmitted (the reset time if it has not)."""
+        return self.arrays.last_sent_s[0]
+
+    @property
+    def channel_costs(self) -> np.ndarray:
+        """Each channel's share of the last step's accuracy cost."""
+        return self.arrays.channel_costs[0]
+
+    @property
+    def channel_rewards(self) -> np.ndarray:
+        """Each channel's reward of the last step (they sum to the step's reward)."""
+        return self.arrays.channel_rewards[0]
+
+    @property
+    def failure(self) -> str | None:
+        """Why the episode ended early, or ``None``."""
+        code = int(self.arrays.failure_code[0])
+        return None if code == 0 else self._failure_message(code)
+
+    def observation_index(self, name: str) -> int:
+        """Position of the named component in the observation vector."""
+        return self.observation_names.index(name)
+
+    # ----------------------------------------------------------------- Gymnasium API
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        arrays = self.arrays
+        for name in ("step_index", "last_sent_s", "transmissions", "interevent_sum_s", "sent"):
+            getattr(arrays, name)[0] = 0
+        for name in ("channel_costs", "channel_rewards", "reward", "cost_sum", "failure_code"):
+            getattr(arrays, name)[0] = 0
+        arrays.interevent_min_s[0] = np.inf
+        self.state[:] = 0.0
+        self._reset_problem(options)
+        arrays.held[0] = self._initial_held()
+        features = np.empty(self.n_features)
+        self.kernels.features(self.state, self.constants, features)
+        arrays.observation[0, : self.n_features] = features
+        arrays.observation[0, self.n_features :] = 0.0
+        return arrays.observation[0].copy(), self.reset_info()
+
+    @staticmethod
+    def reset_info() -> dict[str, Any]:
+        """The ``info`` of a reset (the keys every step's info carries, at their start values)."""
+        return {"transmitted": 0, "transmissions": 0, "time_s": 0.0, "cost": 0.0}
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        arrays = self.arrays
+        if arrays.failure_code[0] != 0 or arrays.step_index[0] >= self.n_steps:
+            raise RuntimeError("step() called after the episode ended; call reset() first")
+        self._actions[0] = self._transmit_bits(action)
+        self.loop_step.serial(
+            self._actions,
+            self._active,
+            arrays,
+            self.constants,
+            self.sampling_period_s,
+            self.n_steps,
+            self.cost_scale,
+            self.transmission_penalty,
+            self.failure_cost,
+        )
+        terminated = bool(arrays.failure_code[0] != 0)
+        truncated = bool(not terminated and arrays.step_index[0] >= self.n_steps)
+        return (
+            arrays.observation[0].copy(),
+            float(arrays.reward[0]),
+            terminated,
+            truncated,
+            self.step_info(terminated or truncated),
+        )
+
+    def step_info(self, ended: bool) -> dict[str, Any]:
+        """The ``info`` of the last step (with ``failure`` and ``episode_metrics`` if it ended
+        the episode)."""
+        arrays = self.arrays
+        info: dict[str, Any] = {
+            "transmitted": int(arrays.sent[0].sum()),
+            "transmissions": int(arrays.transmissions[0].sum()),
+            "time_s": self.time_s,
+            "cost": float(arrays.channel_costs[0].sum()),
+        }
+        if ended:
+            failure = self.failure
+            if failure is not None:
+                info["failure"] = failure
+            info["episode_metrics"] = self.episode_metrics()
+        return info
+
+    def episode_metrics(self) -> dict[str, Any]:
+        """The design page's common metrics and the paper's own, for the episode so far.
+
+        ``transmission_rate`` is transmissions per sampling instant and per channel, so that
+        1.0 means every channel sent at every instant whatever the number of channels.
+        """
+        arrays = self.arrays
+        steps = self.step_index
+        transmissions = arrays.transmissions[0]
+        mean_interevent_s, min_interevent_s = interevent_summary(
+            transmissions, arrays.interevent_sum_s[0], arrays.interevent_min_s[0]
+        )
+        record: dict[str, Any] = {
+            "steps": steps,
+            "sim_time_s": self.time_s,
+            "mean_cost": float(arrays.cost_sum[0]) / steps if steps else 0.0,
+            "transmissions": int(transmissions.sum()),
+            "transmission_rate": (
+                int(transmissions.sum()) / (steps * self.n_channels) if steps else 0.0
+            ),
+            "mean_interevent_s": mean_interevent_s,
+            "min_interevent_s": min_interevent_s,
+            "failure": self.failure,
+        }
+        record.update(self._paper_metrics())
+        return record
+
+    # ----------------------------------------------------------------- internals
+    def _transmit_bits(self, action: Any) -> np.ndarray:
+        """The action as one 0/1 per channel, or ``ValueError`` naming what is allowed."""
+        bits = np.asarray(action)
+        n_channels = self.n_channels
+        if bits.size != n_channels or not np.all((bits == 0) | (bits == 1)):
+            allowed = "0 (hold) or 1 (transmit)" if n_channels == 1 else f"{n_channels} bits of 0/1"
+            raise ValueError(f"action must be {allowed}, got {action!r}")
+        return bits.reshape(n_channels)
