@@ -16,9 +16,19 @@ ENV_IDS = {
 }
 """Gymnasium id → entry point of every registered single-agent environment."""
 
+VECTOR_ENTRY_POINTS = {
+    "etsc/AttitudeTracking-v0": "etsc_envs.attitude_tracking.env:AttitudeTrackingVectorEnv",
+}
+"""Gymnasium id → its native vector environment, for ``gym.make_vec(id, num_envs=n,
+vectorization_mode="vector_entry_point")`` (all sub-environments stepped in one compiled call)."""
+
 for _env_id, _entry_point in ENV_IDS.items():
     if _env_id not in registry:
-        register(id=_env_id, entry_point=_entry_point)
+        register(
+            id=_env_id,
+            entry_point=_entry_point,
+            vector_entry_point=VECTOR_ENTRY_POINTS.get(_env_id),
+        )
 
 PETTINGZOO_ENV_IDS = {
     "etsc/ClusterContainment-v0": "etsc_envs.cluster_containment_v0",

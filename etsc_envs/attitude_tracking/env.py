@@ -40,6 +40,7 @@ from etsc_envs.attitude_tracking.dynamics import (
 )
 from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
 from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.vector_env import EventTriggeredVectorEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector
 from etsc_envs.core.validation import apply_overrides
 
@@ -228,3 +229,10 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             "xi": self.held[0].copy(),
             "u": torque,
         }
+
+
+class AttitudeTrackingVectorEnv(EventTriggeredVectorEnv):
+    """``num_envs`` :class:`AttitudeTrackingEnv` stepped in one compiled call (the id's
+    ``vector_entry_point``)."""
+
+    single_env_class = AttitudeTrackingEnv

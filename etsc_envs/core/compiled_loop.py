@@ -26,11 +26,11 @@ page's step semantics are written once:
 from __future__ import annotations
 
 from collections import namedtuple
+from collections.abc import Callable
 
 import numpy as np
-from numba import prange
 
-from etsc_envs.core.jit import jit, parallel_jit
+from etsc_envs.core.jit import jit
 
 LoopArrays = namedtuple(
     "LoopArrays",
@@ -71,10 +71,6 @@ ProblemKernels = namedtuple(
 namedtuple, the same for every environment of a batch.
 """
 
-LoopStep = namedtuple("LoopStep", ["serial", "parallel"])
-"""The batched step compiled twice: ``serial`` for a single environment and small batches,
-``parallel`` (rows spread over all cores) for large ones."""
-
 
 @jit
 def always_accepts(
@@ -111,10 +107,11 @@ def loop_rows(arrays: LoopArrays, start: int, stop: int) -> LoopArrays:
     return LoopArrays(*(array[start:stop] for array in arrays))
 
 
-def make_loop_step(kernels: ProblemKernels) -> LoopStep:
+def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
     """Compile the step of the module docstring around a problem's kernels.
 
-    Both compiled functions have the signature ``step(actions, active, arrays, constants, h,
+    The compiled function (which releases the GIL, so that threads can step disjoint row
+    ranges of one batch at once) has the signature ``step(actions, active, arrays, constants, h,
     n_steps, cost_scale, transmission_penalty, failure_cost)``: ``actions`` is an ``(n, C)``
     int array of transmit bits, ``active`` an ``(n,)`` bool array of the rows to advance (the
     others are left untouched), ``arrays`` a :class:`LoopArrays` of ``n`` rows. The kernels
@@ -183,7 +180,7 @@ def make_loop_step(kernels: ProblemKernels) -> LoopStep:
             )
 
     @jit
-    def step_serial(
+    def loop_step(
         actions,
         active,
         arrays,
@@ -208,33 +205,7 @@ def make_loop_step(kernels: ProblemKernels) -> LoopStep:
                     failure_cost,
                 )
 
-    @parallel_jit
-    def step_parallel(
-        actions,
-        active,
-        arrays,
-        constants,
-        h,
-        n_steps,
-        cost_scale,
-        transmission_penalty,
-        failure_cost,
-    ):
-        for i in prange(actions.shape[0]):
-            if active[i]:
-                step_row(
-                    i,
-                    actions,
-                    arrays,
-                    constants,
-                    h,
-                    n_steps,
-                    cost_scale,
-                    transmission_penalty,
-                    failure_cost,
-                )
-
-    return LoopStep(serial=step_serial, parallel=step_parallel)
+    return loop_step
 
 
 def interevent_summary(

@@ -20,6 +20,7 @@ vector environment can bind many such environments to the rows of one batch
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -27,7 +28,6 @@ import numpy as np
 
 from etsc_envs.core.compiled_loop import (
     LoopArrays,
-    LoopStep,
     ProblemKernels,
     allocate_loop_arrays,
     interevent_summary,
@@ -58,12 +58,12 @@ class EventTriggeredEnv(gym.Env):
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
     kernels: ClassVar[ProblemKernels]
-    loop_step: ClassVar[LoopStep]
+    loop_step: ClassVar[Callable[..., None]]
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         if "kernels" in cls.__dict__:
-            cls.loop_step = make_loop_step(cls.kernels)
+            cls.loop_step = staticmethod(make_loop_step(cls.kernels))
 
     def __init__(
         self,
@@ -213,7 +213,7 @@ class EventTriggeredEnv(gym.Env):
         if arrays.failure_code[0] != 0 or arrays.step_index[0] >= self.n_steps:
             raise RuntimeError("step() called after the episode ended; call reset() first")
         self._actions[0] = self._transmit_bits(action)
-        self.loop_step.serial(
+        self.loop_step(
             self._actions,
             self._active,
             arrays,

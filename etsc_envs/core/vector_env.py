@@ -1,0 +1,251 @@
+"""Native vector environments: many closed loops of one problem stepped in one compiled call.
+
+:class:`EventTriggeredVectorEnv` builds ``num_envs`` single environments of its
+``single_env_class`` and binds each to one row of a shared batch of loop arrays
+(:mod:`etsc_envs.core.compiled_loop`). A step is one call of the problem's compiled loop step
+over all rows (spread over the cores for large batches); resets run each sub-environment's own
+Python reset on its row, so sub-environment ``j`` reset with seed ``s + j`` follows exactly
+the single environment reset with that seed. Registered as the ids' ``vector_entry_point``::
+
+    envs = gym.make_vec("etsc/AttitudeTracking-v0", num_envs=256,
+                        vectorization_mode="vector_entry_point", transmission_penalty=0.05)
+
+The Gymnasium conventions of ``CartPoleVectorEnv`` hold: ``single_observation_space`` and
+``single_action_space``, info arrays with ``_key`` masks, and autoreset by default at the next
+step (``autoreset_mode="same_step"`` resets in the step that ends an episode and reports
+``final_obs`` / ``final_info``; ``"disabled"`` leaves resets to ``reset(options={"reset_mask":
+...})``). At the end of an episode the info also holds ``failure`` (if any) and
+``episode_metrics`` for that sub-environment.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any, ClassVar
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from etsc_envs.core.compiled_loop import allocate_loop_arrays, loop_rows
+from etsc_envs.core.loop_env import EventTriggeredEnv
+
+ROWS_PER_THREAD_MIN = 8
+"""A batch gets one more thread for every this many rows, up to one per available core
+(threads cost more than they save on a few rows)."""
+
+
+def _worker_count(num_envs: int) -> int:
+    """Threads that step a batch of ``num_envs`` rows."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return max(1, min(cores or 1, num_envs // ROWS_PER_THREAD_MIN))
+
+
+def _row_chunks(num_envs: int, workers: int) -> list[tuple[int, int]]:
+    """``workers`` contiguous ``(start, stop)`` row ranges covering ``num_envs`` rows."""
+    bounds = np.linspace(0, num_envs, workers + 1).round().astype(int)
+    return [(int(bounds[k]), int(bounds[k + 1])) for k in range(workers)]
+
+
+class EventTriggeredVectorEnv(VectorEnv):
+    """``num_envs`` environments of ``single_env_class`` stepped together.
+
+    Args:
+        num_envs: number of sub-environments (>= 1).
+        autoreset_mode: ``"next_step"`` (default), ``"same_step"`` or ``"disabled"`` (a
+            :class:`gymnasium.vector.AutoresetMode` or its value).
+        **env_kwargs: passed to every sub-environment's constructor.
+
+    Subclasses set ``single_env_class``; ``envs`` holds the sub-environments (for their
+    ``episode_metrics()``, ``state_dict()`` and parameters).
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {
+        "render_modes": [],
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+    }
+    single_env_class: ClassVar[type[EventTriggeredEnv]]
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        *,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        **env_kwargs: Any,
+    ) -> None:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer):
+            raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
+        if num_envs < 1:
+            raise ValueError(f"num_envs must be an integer >= 1, got {num_envs}")
+        try:
+            mode = AutoresetMode(autoreset_mode)
+        except ValueError:
+            allowed = [m.value for m in AutoresetMode]
+            raise ValueError(
+                f"autoreset_mode must be one of {allowed}, got {autoreset_mode!r}"
+            ) from None
+        self.metadata = {**self.metadata, "autoreset_mode": mode}
+        self.autoreset_mode = mode
+        self.num_envs = int(num_envs)
+        self.envs = [self.single_env_class(**env_kwargs) for _ in range(self.num_envs)]
+        first = self.envs[0]
+        self.arrays = allocate_loop_arrays(self.num_envs, *first.loop_shape)
+        for index, env in enumerate(self.envs):
+            env.bind(loop_rows(self.arrays, index, index + 1))
+        self.single_observation_space = first.observation_space
+        self.single_action_space = first.action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.render_mode = None
+        self._chunks = _row_chunks(self.num_envs, _worker_count(self.num_envs))
+        self._pool = ThreadPoolExecutor(len(self._chunks)) if len(self._chunks) > 1 else None
+        self._chunk_arrays = [loop_rows(self.arrays, *chunk) for chunk in self._chunks]
+        self._actions = np.zeros((self.num_envs, first.n_channels), dtype=np.int64)
+        self._needs_reset = np.ones(self.num_envs, dtype=bool)
+
+    # ----------------------------------------------------------------- Gymnasium API
+    def reset(
+        self,
+        *,
+        seed: int | list[int | None] | None = None,
+        options: dict[str, Any] | None = None,
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Reset every sub-environment (or those of ``options["reset_mask"]``).
+
+        ``seed``: ``None``, an int ``s`` (sub-environment ``j`` gets ``s + j``) or one seed per
+        sub-environment. Other ``options`` are passed to every sub-environment's reset.
+        """
+        seeds = self._seeds(seed)
+        if isinstance(seed, int):
+            super().reset(seed=seed)
+        env_options = dict(options or {})
+        mask = np.asarray(env_options.pop("reset_mask", np.ones(self.num_envs, dtype=bool)))
+        if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
+            raise ValueError(
+                f"options['reset_mask'] must be a bool array of shape ({self.num_envs},), "
+                f"got {mask!r}"
+            )
+        infos: dict[str, Any] = {}
+        for index in np.flatnonzero(mask):
+            _, info = self.envs[index].reset(seed=seeds[index], options=env_options or None)
+            infos = self._add_info(infos, info, index)
+        self._needs_reset[mask] = False
+        return self.arrays.observation.copy(), infos
+
+    def step(
+        self, actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        self._actions[:] = self._transmit_bits(actions)
+        arrays = self.arrays
+        first = self.envs[0]
+        resetting = self._needs_reset.copy()
+        if resetting.any():
+            if self.autoreset_mode != AutoresetMode.NEXT_STEP:
+                ended = np.flatnonzero(resetting).tolist()
+                raise RuntimeError(
+                    f"step() called on sub-environments {ended} whose episode ended; "
+                    "reset them first (reset(options={'reset_mask': ...}))"
+                )
+            for index in np.flatnonzero(resetting):
+                self.envs[index].reset()
+        self._advance_rows(~resetting)
+        terminated = arrays.failure_code != 0
+        truncated = ~terminated & (arrays.step_index >= first.n_steps)
+        ended = terminated | truncated
+        rewards = arrays.reward.copy()
+        infos: dict[str, Any] = {}
+        for index in np.flatnonzero(ended):
+            env = self.envs[index]
+            end_info = env.step_info(True)
+            if self.autoreset_mode == AutoresetMode.SAME_STEP:
+                final = {"final_obs": arrays.observation[index].copy(), "final_info": end_info}
+                infos = self._add_info(infos, final, index)
+                env.reset()
+            else:
+                extras = {
+                    key: end_info[key] for key in ("failure", "episode_metrics") if key in end_info
+                }
+                infos = self._add_info(infos, extras, index)
+        if self.autoreset_mode == AutoresetMode.SAME_STEP:
+            self._needs_reset[:] = False
+        else:
+            self._needs_reset = ended
+        infos.update(self._step_infos())
+        return arrays.observation.copy(), rewards, terminated, truncated, infos
+
+    def close_extras(self, **kwargs: Any) -> None:
+        if self._pool is not None:
+            self._pool.shutdown()
+        for env in self.envs:
+            env.close()
+
+    # ----------------------------------------------------------------- internals
+    def _advance_rows(self, active: np.ndarray) -> None:
+        """One compiled loop step of the ``active`` rows, each thread on its own row range."""
+        first = self.envs[0]
+
+        def advance(chunk: int) -> None:
+            start, stop = self._chunks[chunk]
+            first.loop_step(
+                self._actions[start:stop],
+                active[start:stop],
+                self._chunk_arrays[chunk],
+                first.constants,
+                first.sampling_period_s,
+                first.n_steps,
+                first.cost_scale,
+                first.transmission_penalty,
+                first.failure_cost,
+            )
+
+        if self._pool is None:
+            advance(0)
+        else:
+            for future in [self._pool.submit(advance, c) for c in range(1, len(self._chunks))]:
+                future.result()
+            advance(0)
+
+    def _step_infos(self) -> dict[str, np.ndarray]:
+        """The per-step info keys of every sub-environment, batched (all present)."""
+        arrays = self.arrays
+        present = np.ones(self.num_envs, dtype=bool)
+        values = {
+            "transmitted": arrays.sent.sum(axis=1),
+            "transmissions": arrays.transmissions.sum(axis=1),
+            "time_s": arrays.step_index * self.envs[0].sampling_period_s,
+            "cost": arrays.channel_costs.sum(axis=1),
+        }
+        infos: dict[str, np.ndarray] = {}
+        for key, value in values.items():
+            infos[key] = value
+            infos[f"_{key}"] = present
+        return infos
+
+    def _seeds(self, seed: int | list[int | None] | None) -> list[int | None]:
+        """One seed per sub-environment, or ``ValueError``."""
+        if seed is None:
+            return [None] * self.num_envs
+        if isinstance(seed, int | np.integer) and not isinstance(seed, bool):
+            return [int(seed) + index for index in range(self.num_envs)]
+        seeds = list(seed)
+        if len(seeds) != self.num_envs:
+            raise ValueError(
+                f"seed must be None, an int or {self.num_envs} seeds (one per sub-environment), "
+                f"got {len(seeds)}"
+            )
+        return seeds
+
+    def _transmit_bits(self, actions: Any) -> np.ndarray:
+        """The actions as an ``(num_envs, n_channels)`` array of 0/1, or ``ValueError``."""
+        bits = np.asarray(actions)
+        n_channels = self._actions.shape[1]
+        shape = (self.num_envs,) if n_channels == 1 else (self.num_envs, n_channels)
+        if bits.shape not in (shape, (self.num_envs, n_channels)) or not np.all(
+            (bits == 0) | (bits == 1)
+        ):
+            raise ValueError(
+                f"actions must be an array of shape {shape} holding 0 (hold) or 1 (transmit), "
+                f"got shape {bits.shape}"
+            )
+        return bits.reshape(self.num_envs, n_channels)
