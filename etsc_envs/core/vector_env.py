@@ -36,6 +36,16 @@ ROWS_PER_THREAD_MIN = 8
 (threads cost more than they save on a few rows)."""
 
 
+def _autoreset_mode(value: AutoresetMode | str) -> AutoresetMode:
+    """The mode named by ``value`` (an :class:`AutoresetMode`, its value such as
+    ``"SameStep"``, or its name such as ``"same_step"``), or ``ValueError``."""
+    for mode in AutoresetMode:
+        if value in (mode, mode.value) or str(value).upper() == mode.name:
+            return mode
+    allowed = [mode.name.lower() for mode in AutoresetMode]
+    raise ValueError(f"autoreset_mode must be one of {allowed}, got {value!r}")
+
+
 def _worker_count(num_envs: int) -> int:
     """Threads that step a batch of ``num_envs`` rows."""
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
@@ -53,8 +63,8 @@ class EventTriggeredVectorEnv(VectorEnv):
 
     Args:
         num_envs: number of sub-environments (>= 1).
-        autoreset_mode: ``"next_step"`` (default), ``"same_step"`` or ``"disabled"`` (a
-            :class:`gymnasium.vector.AutoresetMode` or its value).
+        autoreset_mode: ``"next_step"`` (default), ``"same_step"`` or ``"disabled"`` (or the
+            :class:`gymnasium.vector.AutoresetMode` itself).
         **env_kwargs: passed to every sub-environment's constructor.
 
     Subclasses set ``single_env_class``; ``envs`` holds the sub-environments (for their
@@ -78,13 +88,7 @@ class EventTriggeredVectorEnv(VectorEnv):
             raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
         if num_envs < 1:
             raise ValueError(f"num_envs must be an integer >= 1, got {num_envs}")
-        try:
-            mode = AutoresetMode(autoreset_mode)
-        except ValueError:
-            allowed = [m.value for m in AutoresetMode]
-            raise ValueError(
-                f"autoreset_mode must be one of {allowed}, got {autoreset_mode!r}"
-            ) from None
+        mode = _autoreset_mode(autoreset_mode)
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.autoreset_mode = mode
         self.num_envs = int(num_envs)
