@@ -9,7 +9,8 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``policy`` — an SB3 policy alias of that algorithm, e.g. ``MlpPolicy``;
 * ``hyperparameters: {}`` — keyword arguments of the algorithm's constructor;
 * ``total_timesteps`` — environment steps to train for, summed over the vectorised envs;
-* ``n_envs: 1`` — environments stepped together in one ``DummyVecEnv``;
+* ``n_envs: 1`` — environments stepped together (in the id's native vector env, one compiled
+  call per step);
 * ``seed: 0`` — seeds the algorithm and the environments (``null`` leaves them unseeded);
 * ``out_dir`` — where the model, the resolved config and the summary are written.
 

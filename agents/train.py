@@ -25,9 +25,10 @@ import yaml
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.env_util import make_vec_env
-from stable_baselines3.common.vec_env import DummyVecEnv
+from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor
 
 from agents.config import TrainConfig, load_config
+from agents.vector_adapter import make_sb3_vec_env
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
@@ -69,13 +70,7 @@ def train(config: TrainConfig) -> Path:
     """Train the configured model, write the three output files and return the output folder."""
     out_dir = Path(config.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    env = make_vec_env(
-        functools.partial(gym.make, config.env_id),
-        n_envs=config.n_envs,
-        seed=config.seed,
-        env_kwargs=config.env_kwargs,
-        vec_env_cls=DummyVecEnv,
-    )
+    env = make_training_env(config)
     model = config.algorithm_class(config.policy, env, seed=config.seed, **config.hyperparameters)
     metrics_callback = EpisodeMetricsCallback()
     start = time.perf_counter()
@@ -91,6 +86,23 @@ def train(config: TrainConfig) -> Path:
     summary = _summary(config, model, metrics_callback, wall_time_s)
     (out_dir / SUMMARY_FILE).write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     return out_dir
+
+
+def make_training_env(config: TrainConfig) -> VecEnv:
+    """``config.n_envs`` environments of ``config.env_id`` as one SB3 ``VecEnv`` with episode
+    statistics: the id's native vector env through :class:`SB3VecEnvAdapter` when it has one
+    (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs."""
+    if gym.spec(config.env_id).vector_entry_point is not None:
+        env = make_sb3_vec_env(config.env_id, config.n_envs, **config.env_kwargs)
+        env.seed(config.seed)
+        return VecMonitor(env)
+    return make_vec_env(
+        functools.partial(gym.make, config.env_id),
+        n_envs=config.n_envs,
+        seed=config.seed,
+        env_kwargs=config.env_kwargs,
+        vec_env_cls=DummyVecEnv,
+    )
 
 
 def _progress_bar_available() -> bool:
