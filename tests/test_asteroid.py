@@ -285,7 +285,7 @@ def test_decision_interval_only_changes_when_the_agent_decides():
     )
     for key in ("min_radius_m", "max_radius_m", "delta_v_mps", "bursts"):
         assert_allclose(coarse_metrics[key], fine_metrics[key], rtol=1e-12)
-    assert_allclose(coarse.unwrapped.cost_sum, fine.unwrapped.cost_sum, rtol=1e-12)
+    assert_allclose(coarse.unwrapped.arrays.cost_sum, fine.unwrapped.arrays.cost_sum, rtol=1e-12)
 
 
 # --------------------------------------------------------------------------- reward, metrics

@@ -193,7 +193,7 @@ def test_transmitting_one_axis_refreshes_only_that_axis():
     assert np.all(np.abs(obs[error]) > 0.0)
     obs, reward, _, _, info = env.step(np.array([0, 1, 0]))
     assert info["transmitted"] == 1
-    assert_array_equal(env.channel.transmissions, [0, 1, 0])
+    assert_array_equal(env.transmissions, [0, 1, 0])
     assert abs(obs[1]) < abs(obs[0]) and abs(obs[1]) < abs(obs[2])
     assert_allclose(obs[clock], [0.051, 0.001, 0.051], atol=1e-6)
     assert_allclose(reward, -info["cost"] / env.cost_scale - env.transmission_penalty, rtol=1e-6)

@@ -21,7 +21,7 @@ SHORT_EPISODE = {
     "etsc/InnerFormation-v0": {"horizon_s": 0.02},
     "etsc/OrbitAttitudeTracking-v0": {"horizon_s": 0.02},
     "etsc/ClusterContainmentCentral-v0": {"horizon_s": 0.2},
-    "etsc/AsteroidOrbitKeeping-v0": {"horizon_s": 5.0},
+    "etsc/AsteroidOrbitKeeping-v0": {"horizon_s": 5.0, "burst_duration_s": 2.0},
 }
 """Kwargs that make an episode about 20 steps long, so that tests cross an autoreset."""
 

@@ -6,9 +6,16 @@ state feedback, so they are evaluated inside the RK4 derivative together with eq
 the sampling periods that start less than ``burst_duration`` after the triggering instant
 (section 4: "the thrusters work for 50 s after each time of triggering"). One decision period is
 ``n_substeps`` sampling periods of ``h`` (0.25 s in section 4).
+
+The environment keeps one loop in a flat state row (layout below) and reaches it through the
+kernels of :data:`KERNELS` (see :mod:`etsc_envs.core.compiled_loop`). Its single channel
+carries the triggering instant: the held value is the start of the last accepted burst (NaN
+before the first), and a request while that burst runs is refused.
 """
 
 from __future__ import annotations
+
+from collections import namedtuple
 
 import numpy as np
 
@@ -23,6 +30,7 @@ from etsc_envs.asteroid.controller import (
 from etsc_envs.asteroid.dynamics import (
     B_HAT,
     DELTA_V,
+    STATE_SIZE,
     PlantModel,
     Q,
     R,
@@ -32,12 +40,42 @@ from etsc_envs.asteroid.dynamics import (
 )
 from etsc_envs.asteroid.gravity import Polyhedron
 from etsc_envs.asteroid.gravity_grid import collides, grid_clearance
+from etsc_envs.core.compiled_loop import ProblemKernels
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
 from etsc_envs.core.rotations import error_quaternion
 
 N_FEATURES = 14
 OK, NON_FINITE, LEFT_REGION, COLLISION, ATTITUDE_DIVERGED = 0, 1, 2, 3, 4
+
+PLANT = slice(0, STATE_SIZE)  # y = [r, v, q, ω, b̂, Δv] of dynamics.py
+FEATURES = slice(15, 29)  # orbit_features at the current instant
+SUN_DIRECTION = slice(29, 32)  # the Sun's unit vector in I, from the episode's Sun azimuth
+DESIRED_ATTITUDE = slice(32, 36)  # q_D of eq. (18): the Sun-pointing frame
+MIN_RADIUS = 36  # least ‖r‖ so far (at the reset and the substeps' ends), m
+MAX_RADIUS = 37  # greatest ‖r‖ so far, m
+TIME_OUTSIDE = 38  # time spent outside the shell, s
+MIN_CLEARANCE = 39  # least height above the surface so far, m
+FAILURE_CODE = 40  # OK or the failure of the last decision period
+STATE_WIDTH = 41
+"""Layout of the state row."""
+
+LoopConstants = namedtuple(
+    "LoopConstants",
+    [
+        "gains",  # LoopGains (q_D is taken from the state row)
+        "model",  # PlantModel (the Sun's direction is taken from the state row)
+        "polyhedron",  # Polyhedron of the body, for the exact collision test
+        "substep_s",  # h: the sampling period, s
+        "substeps",  # sampling periods per decision period
+        "burst_duration",  # s
+        "shell",  # (r_min, r_max), m
+        "region",  # the operating region's (inner, outer) radii, m
+        "max_rate",  # divergence bound on ‖ω‖, rad/s
+    ],
+)
+"""What every episode shares: gains, plant model and body, the sampling and burst timing, and
+the cost and failure bounds."""
 
 
 @jit
@@ -155,3 +193,122 @@ def closed_loop_step(
         min_clearance,
         features,
     )
+
+
+@jit
+def episode_gains(state: np.ndarray, constants: LoopConstants) -> LoopGains:
+    """The controller gains of the episode: the shared ones with the state row's q_D."""
+    shared = constants.gains
+    return LoopGains(
+        shared.reference_radius,
+        shared.shell_half_width,
+        shared.thrust_gain,
+        shared.max_thrust,
+        shared.attitude_gain,
+        shared.sliding_gain,
+        shared.adaptive_rate,
+        shared.adaptive_leakage,
+        shared.tanh_sharpness,
+        state[DESIRED_ATTITUDE],
+    )
+
+
+@jit
+def episode_model(state: np.ndarray, constants: LoopConstants) -> PlantModel:
+    """The plant model of the episode: the shared one with the state row's Sun direction."""
+    shared = constants.model
+    return PlantModel(
+        shared.gm,
+        shared.spin_rate,
+        shared.mass,
+        shared.inertia,
+        shared.srp_pressure_area,
+        shared.srp_normal_coefficient,
+        shared.srp_sun_coefficient,
+        shared.srp_arm,
+        shared.thrust_arm,
+        shared.perturbation_scale,
+        state[SUN_DIRECTION],
+        shared.grid,
+    )
+
+
+@jit
+def channel_values(state: np.ndarray, constants: LoopConstants, time_s: float) -> np.ndarray:
+    """The trigger's transmission: the instant t_k at which the burst starts."""
+    return np.full((1, 1), time_s)
+
+
+@jit
+def accepts_burst(
+    state: np.ndarray, held: np.ndarray, constants: LoopConstants, time_s: float, channel: int
+) -> bool:
+    """A burst can start unless the one begun at the held instant still fires."""
+    return not is_thrusting(time_s, held[0, 0], constants.burst_duration)
+
+
+@jit
+def advance_loop(
+    state: np.ndarray,
+    constants: LoopConstants,
+    step_index: int,
+    h: float,
+    held: np.ndarray,
+    sent: np.ndarray,
+    channel_costs: np.ndarray,
+) -> None:
+    """One decision period in the state row; the cost is ∫ d² dt outside the shell."""
+    (
+        plant,
+        _,
+        failure,
+        cost,
+        time_outside,
+        min_radius,
+        max_radius,
+        min_clearance,
+        features,
+    ) = closed_loop_step(
+        step_index * h,
+        state[PLANT],
+        constants.substep_s,
+        constants.substeps,
+        held[0, 0],
+        constants.burst_duration,
+        constants.shell,
+        constants.region,
+        constants.max_rate,
+        episode_gains(state, constants),
+        episode_model(state, constants),
+        constants.polyhedron,
+    )
+    state[PLANT] = plant
+    state[FEATURES] = features
+    state[FAILURE_CODE] = failure
+    state[TIME_OUTSIDE] += time_outside
+    state[MIN_RADIUS] = min(state[MIN_RADIUS], min_radius)
+    state[MAX_RADIUS] = max(state[MAX_RADIUS], max_radius)
+    state[MIN_CLEARANCE] = min(state[MIN_CLEARANCE], min_clearance)
+    channel_costs[0] = cost
+
+
+@jit
+def loop_failure(state: np.ndarray, constants: LoopConstants) -> int:
+    """The failure closed_loop_step found in the last decision period (OK for none)."""
+    return int(state[FAILURE_CODE])
+
+
+@jit
+def loop_features(state: np.ndarray, constants: LoopConstants, out: np.ndarray) -> None:
+    """The observation's features, as computed by the last step (or the reset)."""
+    out[:] = state[FEATURES]
+
+
+KERNELS = ProblemKernels(
+    channel_values=channel_values,
+    accepts=accepts_burst,
+    advance=advance_loop,
+    failure=loop_failure,
+    features=loop_features,
+)
+"""The compiled loop of paper 003."""

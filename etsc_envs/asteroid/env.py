@@ -19,10 +19,21 @@ from etsc_envs.asteroid.body import asteroid_body, resolve_shape
 from etsc_envs.asteroid.closed_loop import (
     ATTITUDE_DIVERGED,
     COLLISION,
+    DESIRED_ATTITUDE,
+    FEATURES,
+    KERNELS,
     LEFT_REGION,
+    MAX_RADIUS,
+    MIN_CLEARANCE,
+    MIN_RADIUS,
     NON_FINITE,
-    OK,
-    closed_loop_step,
+    PLANT,
+    STATE_WIDTH,
+    SUN_DIRECTION,
+    TIME_OUTSIDE,
+    LoopConstants,
+    episode_gains,
+    episode_model,
     is_thrusting,
     orbit_features,
 )
@@ -50,7 +61,7 @@ from etsc_envs.asteroid.gravity import GRAVITATIONAL_CONSTANT
 from etsc_envs.asteroid.gravity_grid import collides
 from etsc_envs.asteroid.params import AsteroidParams
 from etsc_envs.asteroid.shape import ShapeModel
-from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.rotations import (
     error_quaternion,
     quat_angle,
@@ -60,6 +71,7 @@ from etsc_envs.core.rotations import (
     quat_to_euler321,
 )
 from etsc_envs.core.validation import apply_overrides
+from etsc_envs.core.vector_env import EventTriggeredVectorEnv
 
 FEATURE_NAMES = (
     "radius_m",
@@ -101,6 +113,15 @@ FAILURE_MESSAGES = {
 }
 
 
+def sun_pointing(sun_azimuth_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """The Sun's unit vector in I at ``sun_azimuth_deg`` in the equatorial plane, and q_D of
+    eq. (18), the frame that turns the solar panel (body x) toward it."""
+    azimuth = math.radians(sun_azimuth_deg)
+    direction = np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
+    desired = quat_from_rotation_vector(np.array([0.0, 0.0, azimuth]))
+    return direction, desired
+
+
 class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
     """Barrier-triggered orbit keeping near asteroid Itokawa (paper 003).
 
@@ -128,6 +149,8 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
     Action: ``Discrete(2)``, 1 starts a thrust burst (refused, not counted and not charged
     while one is running). Observation: :data:`FEATURE_NAMES` then ``time_since_transmission_s``.
     """
+
+    kernels = KERNELS
 
     def __init__(
         self,
@@ -176,18 +199,6 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             ("clearance_m", (-reach, reach)),
         ):
             low[FEATURE_NAMES.index(name)], high[FEATURE_NAMES.index(name)] = bounds
-        super().__init__(
-            feature_names=FEATURE_NAMES,
-            feature_low=low,
-            feature_high=high,
-            n_channels=1,
-            channel_width=1,
-            sampling_period_s=decision_period,
-            horizon_s=p.horizon_s,
-            transmission_penalty=transmission_penalty,
-            cost_scale=cost_scale,
-            failure_cost=worst_outside**2 * decision_period,
-        )
         self.body = asteroid_body(
             resolve_shape(shape, shape_length_unit_m),
             p.asteroid_mass_kg,
@@ -195,14 +206,32 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             p.grid_spacing_m,
         )
         self.gm = GRAVITATIONAL_CONSTANT * p.asteroid_mass_kg
-        self.shell = np.array(shell)
-        self.region = np.array(region, dtype=float)
-        self.gains = self._gains(p.sun_azimuth_deg)
-        self.model = self._model(p.sun_azimuth_deg)
-        self.state = np.zeros(STATE_SIZE)
-        self._features_now = np.zeros(len(FEATURE_NAMES))
-        self._failure_code = OK
-        self._metrics = self._fresh_metrics()
+        sun_direction, desired_attitude = sun_pointing(p.sun_azimuth_deg)
+        super().__init__(
+            feature_names=FEATURE_NAMES,
+            feature_low=low,
+            feature_high=high,
+            n_channels=1,
+            channel_width=1,
+            state_width=STATE_WIDTH,
+            constants=LoopConstants(
+                gains=self._gains(desired_attitude),
+                model=self._model(sun_direction),
+                polyhedron=self.body.polyhedron,
+                substep_s=float(p.sampling_period_s),
+                substeps=self.decision_interval,
+                burst_duration=float(p.burst_duration_s),
+                shell=np.array(shell),
+                region=np.array(region, dtype=float),
+                max_rate=float(p.max_rate_rad_s),
+            ),
+            sampling_period_s=decision_period,
+            horizon_s=p.horizon_s,
+            transmission_penalty=transmission_penalty,
+            cost_scale=cost_scale,
+            failure_cost=worst_outside**2 * decision_period,
+        )
+        self._point_at_sun(p.sun_azimuth_deg)
         start = self._initial_state(
             p.orbit_plane_azimuth_deg,
             p.initial_orbit_phase_deg,
@@ -219,7 +248,7 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             )
 
     # ----------------------------------------------------------------- construction helpers
-    def _gains(self, sun_azimuth_deg: float) -> LoopGains:
+    def _gains(self, desired_attitude: np.ndarray) -> LoopGains:
         p = self.params
         return LoopGains(
             reference_radius=float(p.reference_radius_m),
@@ -231,14 +260,11 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             adaptive_rate=float(p.adaptive_rate),
             adaptive_leakage=float(p.adaptive_leakage),
             tanh_sharpness=float(p.tanh_sharpness),
-            desired_attitude=quat_from_rotation_vector(
-                np.array([0.0, 0.0, math.radians(sun_azimuth_deg)])
-            ),
+            desired_attitude=desired_attitude,
         )
 
-    def _model(self, sun_azimuth_deg: float) -> PlantModel:
+    def _model(self, sun_direction: np.ndarray) -> PlantModel:
         p = self.params
-        azimuth = math.radians(sun_azimuth_deg)
         return PlantModel(
             gm=self.gm,
             spin_rate=p.spin_rate_rad_s,
@@ -250,9 +276,13 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             srp_arm=np.array([0.0, p.srp_offset_m, 0.0]),
             thrust_arm=np.array([0.0, p.thrust_offset_m, 0.0]),
             perturbation_scale=1.0 if p.orbit_perturbations else 0.0,
-            sun_inertial=np.array([math.cos(azimuth), math.sin(azimuth), 0.0]),
+            sun_inertial=sun_direction,
             grid=self.body.grid,
         )
+
+    def _point_at_sun(self, sun_azimuth_deg: float) -> None:
+        """Write the episode's Sun direction and the Sun-pointing q_D into the state row."""
+        self.state[SUN_DIRECTION], self.state[DESIRED_ATTITUDE] = sun_pointing(sun_azimuth_deg)
 
     def _initial_speed(self) -> float:
         """‖v(0)‖ of eq. (20): sqrt(G M / r_0) unless ``initial_speed_mps`` is set."""
@@ -270,8 +300,9 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
         attitude_rotation: np.ndarray,
     ) -> np.ndarray:
         """y(0): r and ṙ on the orbit of eq. (20) through the plane at ``azimuth_deg`` (which
-        contains z), ``phase_deg`` from the equator; the attitude error of section 4 composed
-        with ``attitude_rotation`` (rotation vector); ω(0) and b̂(0) of the parameters."""
+        contains z), ``phase_deg`` from the equator; the attitude error of section 4 about the
+        state row's q_D composed with ``attitude_rotation`` (rotation vector); ω(0) and b̂(0) of
+        the parameters."""
         p = self.params
         azimuth, phase = math.radians(azimuth_deg), math.radians(phase_deg)
         node = np.array([math.cos(azimuth), math.sin(azimuth), 0.0])
@@ -283,28 +314,19 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
         y = np.zeros(STATE_SIZE)
         y[R] = radius_m * (math.cos(phase) * node + math.sin(phase) * pole)
         y[V] = speed_mps * (-math.sin(phase) * node + math.cos(phase) * pole)
-        y[Q] = quat_multiply(self.gains.desired_attitude, attitude_error)
+        y[Q] = quat_multiply(self.state[DESIRED_ATTITUDE], attitude_error)
         y[W] = np.array(p.initial_rate_rad_s, dtype=float)
         y[B_HAT] = p.adaptive_initial
         return y
 
-    @staticmethod
-    def _fresh_metrics() -> dict[str, float]:
-        return {
-            "min_radius_m": math.inf,
-            "max_radius_m": 0.0,
-            "time_outside_s": 0.0,
-            "min_clearance_m": math.inf,
-        }
-
     # ----------------------------------------------------------------- hooks
     def _reset_problem(self, options: dict[str, Any] | None) -> None:
         p = self.params
+        state = self.state
         speed = self._initial_speed()
         if not self.randomize:
-            self.gains = self._gains(p.sun_azimuth_deg)
-            self.model = self._model(p.sun_azimuth_deg)
-            self.state = self._initial_state(
+            self._point_at_sun(p.sun_azimuth_deg)
+            state[PLANT] = self._initial_state(
                 p.orbit_plane_azimuth_deg,
                 p.initial_orbit_phase_deg,
                 p.initial_radius_m,
@@ -312,130 +334,102 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
                 np.zeros(3),
             )
         else:
-            self.state = self._random_initial_state(speed)
-        self._failure_code = OK
-        self._metrics = self._fresh_metrics()
-        radius = float(np.linalg.norm(self.state[R]))
-        self._metrics["min_radius_m"] = self._metrics["max_radius_m"] = radius
-        self._features_now = orbit_features(
-            0.0, self.state, np.nan, p.burst_duration_s, self.gains, self.body.grid
+            state[PLANT] = self._random_initial_state(speed)
+        state[MIN_RADIUS] = state[MAX_RADIUS] = np.linalg.norm(state[R])
+        state[FEATURES] = orbit_features(
+            0.0, state[PLANT], np.nan, p.burst_duration_s, self.gains, self.body.grid
         )
-        self._metrics["min_clearance_m"] = float(self._features_now[-1])
+        state[MIN_CLEARANCE] = state[FEATURES][-1]
 
     def _random_initial_state(self, speed: float) -> np.ndarray:
-        """A start drawn from the ranges of the class docstring, outside the body."""
+        """A start drawn from the ranges of the class docstring, outside the body (the Sun's
+        azimuth is written into the state row)."""
         p = self.params
         rng = self.np_random
         for _ in range(RANDOM_DRAWS):
-            sun_azimuth = rng.uniform(0.0, 360.0)
-            self.gains = self._gains(sun_azimuth)
-            self.model = self._model(sun_azimuth)
+            self._point_at_sun(rng.uniform(0.0, 360.0))
             axis = rng.normal(size=3)
             axis /= np.linalg.norm(axis)
             angle = math.radians(rng.uniform(0.0, RANDOM_ATTITUDE_MAX_DEG))
-            state = self._initial_state(
+            y = self._initial_state(
                 p.orbit_plane_azimuth_deg + rng.uniform(-RANDOM_AZIMUTH_DEG, RANDOM_AZIMUTH_DEG),
                 p.initial_orbit_phase_deg + rng.uniform(-RANDOM_PHASE_DEG, RANDOM_PHASE_DEG),
                 p.initial_radius_m + rng.uniform(-RANDOM_RADIUS_M, RANDOM_RADIUS_M),
                 speed * (1.0 + rng.uniform(-RANDOM_SPEED_FRACTION, RANDOM_SPEED_FRACTION)),
                 angle * axis,
             )
-            radius = np.linalg.norm(state[R])
-            inside_region = self.region[0] < radius < self.region[1]
-            if inside_region and not collides(state[R], self.body.grid, self.body.polyhedron):
-                return state
+            radius = np.linalg.norm(y[R])
+            inside_region = self.constants.region[0] < radius < self.constants.region[1]
+            if inside_region and not collides(y[R], self.body.grid, self.body.polyhedron):
+                return y
         raise RuntimeError(f"no random start outside the body in {RANDOM_DRAWS} draws")
+
+    def _initial_held(self) -> np.ndarray:
+        """No burst has started: the held triggering instant is NaN."""
+        return np.full((1, 1), np.nan)
+
+    def _failure_message(self, code: int) -> str:
+        radius = float(np.linalg.norm(self.state[R]))
+        detail = f"|r| = {radius:.2f} m near t = {self.time_s:.2f} s"
+        if code == LEFT_REGION:
+            low, high = self.params.operating_region_m
+            detail += f", outside operating_region_m = [{low:g}, {high:g}] m"
+        if code == ATTITUDE_DIVERGED:
+            detail = f"|omega| > max_rate_rad_s = {self.params.max_rate_rad_s} rad/s"
+        return f"{FAILURE_MESSAGES[code]}: {detail}"
+
+    def _paper_metrics(self) -> dict[str, Any]:
+        state = self.state
+        return {
+            "min_radius_m": float(state[MIN_RADIUS]),
+            "max_radius_m": float(state[MAX_RADIUS]),
+            "time_outside_s": float(state[TIME_OUTSIDE]),
+            "min_clearance_m": float(state[MIN_CLEARANCE]),
+            "delta_v_mps": float(state[DELTA_V]),
+            "bursts": int(self.transmissions[0]),
+            "att_err_final_deg": math.degrees(quat_angle(self._attitude_error())),
+        }
+
+    # ----------------------------------------------------------------- episode parameters
+    @property
+    def gains(self) -> LoopGains:
+        """The controller gains of the current episode (with its Sun-pointing q_D)."""
+        return episode_gains(self.state, self.constants)
+
+    @property
+    def model(self) -> PlantModel:
+        """The plant model of the current episode (with its Sun direction)."""
+        return episode_model(self.state, self.constants)
 
     @property
     def burst_start_s(self) -> float:
         """When the last accepted burst began (NaN before the first)."""
-        if self.channel.transmissions[0] == 0:
-            return math.nan
-        return float(self.channel.last_sent_s[0])
+        return float(self.held[0, 0])
 
     def burst_active(self) -> bool:
         """Whether the thrusters fire during the sampling period that starts now."""
         return bool(is_thrusting(self.time_s, self.burst_start_s, self.params.burst_duration_s))
 
-    def _accepts_transmission(self) -> np.ndarray:
-        return np.array([not self.burst_active()])
-
-    def _channel_values(self) -> np.ndarray:
-        return np.array([self.time_s])
-
-    def _advance(self) -> float:
-        p = self.params
-        (
-            self.state,
-            _,
-            self._failure_code,
-            cost,
-            time_outside,
-            min_radius,
-            max_radius,
-            min_clearance,
-            self._features_now,
-        ) = closed_loop_step(
-            self.time_s,
-            self.state,
-            p.sampling_period_s,
-            self.decision_interval,
-            self.burst_start_s,
-            p.burst_duration_s,
-            self.shell,
-            self.region,
-            p.max_rate_rad_s,
-            self.gains,
-            self.model,
-            self.body.polyhedron,
-        )
-        metrics = self._metrics
-        metrics["time_outside_s"] += time_outside
-        metrics["min_radius_m"] = min(metrics["min_radius_m"], min_radius)
-        metrics["max_radius_m"] = max(metrics["max_radius_m"], max_radius)
-        metrics["min_clearance_m"] = min(metrics["min_clearance_m"], min_clearance)
-        return cost
-
-    def _failure(self) -> str | None:
-        if self._failure_code == OK:
-            return None
-        radius = float(np.linalg.norm(self.state[R]))
-        detail = f"|r| = {radius:.2f} m near t = {self.time_s:.2f} s"
-        if self._failure_code == LEFT_REGION:
-            low, high = self.params.operating_region_m
-            detail += f", outside operating_region_m = [{low:g}, {high:g}] m"
-        if self._failure_code == ATTITUDE_DIVERGED:
-            detail = f"|omega| > max_rate_rad_s = {self.params.max_rate_rad_s} rad/s"
-        return f"{FAILURE_MESSAGES[self._failure_code]}: {detail}"
-
-    def _features(self) -> np.ndarray:
-        return self._features_now
-
-    def _paper_metrics(self) -> dict[str, Any]:
-        metrics = dict(self._metrics)
-        metrics["delta_v_mps"] = float(self.state[DELTA_V])
-        metrics["bursts"] = int(self.channel.transmissions[0])
-        metrics["att_err_final_deg"] = math.degrees(quat_angle(self._attitude_error()))
-        return metrics
-
     # ----------------------------------------------------------------- diagnostics
     def _attitude_error(self) -> np.ndarray:
-        return error_quaternion(self.state[Q], self.gains.desired_attitude)
+        return error_quaternion(self.state[Q], self.state[DESIRED_ATTITUDE])
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """Named copies of the loop's signals at the current instant (for plots and tests)."""
         t = self.time_s
-        y = self.state
+        y = self.state[PLANT]
+        gains = self.gains
+        model = self.model
         q_error = self._attitude_error()
-        s = sliding_vector(q_error, y[W], self.gains)
+        s = sliding_vector(q_error, y[W], gains)
         thrusting = self.burst_active()
-        thrust = thrust_law(y[R], self.gains) if thrusting else np.zeros(3)
+        thrust = thrust_law(y[R], gains) if thrusting else np.zeros(3)
         return {
             "time_s": np.array(t),
             "position_m": y[R].copy(),
             "velocity_mps": y[V].copy(),
             "radius_m": np.array(np.linalg.norm(y[R])),
-            "barrier_m2ps": np.array(barrier_statistic(y[R], y[V], self.gains.reference_radius)),
+            "barrier_m2ps": np.array(barrier_statistic(y[R], y[V], gains.reference_radius)),
             "burst_active": np.array(float(thrusting)),
             "thrust_n": thrust,
             "delta_v_mps": np.array(y[DELTA_V]),
@@ -445,9 +439,16 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             "euler_error_deg": np.degrees(quat_to_euler321(q_error)),
             "omega_rad_s": y[W].copy(),
             "b_hat": np.array(y[B_HAT]),
-            "control_torque_nm": attitude_law(s, y[B_HAT], self.gains),
-            "sun_direction_body": asteroid_to_body(t, y[Q], self.model.spin_rate)
-            @ (inertial_to_asteroid(t, self.model.spin_rate) @ self.model.sun_inertial),
-            "clearance_m": np.array(self._features_now[-1]),
-            "jacobi_m2ps2": np.array(jacobi_integral(y[R], y[V], self.model)),
+            "control_torque_nm": attitude_law(s, y[B_HAT], gains),
+            "sun_direction_body": asteroid_to_body(t, y[Q], model.spin_rate)
+            @ (inertial_to_asteroid(t, model.spin_rate) @ model.sun_inertial),
+            "clearance_m": np.array(self.state[FEATURES][-1]),
+            "jacobi_m2ps2": np.array(jacobi_integral(y[R], y[V], model)),
         }
+
+
+class AsteroidOrbitKeepingVectorEnv(EventTriggeredVectorEnv):
+    """``num_envs`` :class:`AsteroidOrbitKeepingEnv` stepped in one compiled call (the id's
+    ``vector_entry_point``)."""
+
+    single_env_class = AsteroidOrbitKeepingEnv

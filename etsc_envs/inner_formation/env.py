@@ -12,9 +12,28 @@ from typing import Any
 
 import numpy as np
 
-from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.validation import apply_overrides
-from etsc_envs.inner_formation.closed_loop import closed_loop_step, sensor_features
+from etsc_envs.core.vector_env import EventTriggeredVectorEnv
+from etsc_envs.inner_formation.closed_loop import (
+    CONTROL,
+    CONTROL_NORM_SUM,
+    DISTURBANCE_PHASE,
+    EXTREMES,
+    FEATURES,
+    KERNELS,
+    LOOP,
+    NON_FINITE,
+    RETRANSMIT_ERROR_MIN,
+    SAMPLING_ERROR_MAX,
+    STATE_WIDTH,
+    STEADY_ERROR_MAX,
+    STEADY_OFFSET_MAX,
+    LoopConstants,
+    episode_model,
+    offset_norm,
+    sensor_features,
+)
 from etsc_envs.inner_formation.controller import ObserverFeedback
 from etsc_envs.inner_formation.design import estimation_bounds, zeno_bound_s
 from etsc_envs.inner_formation.dynamics import RelativeMotionModel, lumped_term
@@ -42,6 +61,13 @@ RANDOM_POSITION_MAX_M = 0.02
 RANDOM_VELOCITY_MAX_MPS = 1e-3
 
 
+def steady_start_step(params: InnerFormationParams) -> int:
+    """The first step of the steady-state window, the last :data:`STEADY_FRACTION` of the
+    horizon's sampling instants."""
+    n_steps = round(params.horizon_s / params.sampling_period_s)
+    return int(np.floor((1.0 - STEADY_FRACTION) * n_steps))
+
+
 class InnerFormationEnv(EventTriggeredEnv):
     """Inner-formation relative motion with per-axis event-triggered ESOs (paper 004).
 
@@ -49,13 +75,16 @@ class InnerFormationEnv(EventTriggeredEnv):
         params: the paper's model and scenario; keyword overrides of its fields are applied on
             top (for example ``horizon_s=50``, ``initial_position_m=(0.002, 0, 0)``).
         transmission_penalty: λ, reward lost per transmitted axis.
-        cost_scale: the per-step cost Σ_i |r_i| + Σ_i |r_i - ζ_i| (m) is divided by this.
+        cost_scale: the per-step cost Σ_i |r_i| + Σ_i |r_i - ζ_i| (m) is divided by this; axis
+            i's share is |r_i| + |r_i - ζ_i|.
         randomize: draw the initial offset (uniform direction, norm up to 2 cm), the initial
             velocity (each axis uniform in ±1 mm/s) and the phases of Δa (uniform in [0, 2π))
             at every reset instead of the fixed defaults.
 
     Action: ``MultiBinary(3)``; bit i transmits r_i(t_k) to axis i's observer.
     """
+
+    kernels = KERNELS
 
     def __init__(
         self,
@@ -71,6 +100,18 @@ class InnerFormationEnv(EventTriggeredEnv):
         )
         self.randomize = bool(randomize)
         p = self.params
+        self.design = ObserverFeedback(
+            gain=np.array(p.observer_gain, dtype=float),
+            beta=np.array(p.observer_beta, dtype=float),
+            feedback=p.feedback_scale * np.array(p.feedback_gains, dtype=float),
+        )
+        self.steady_start_step = steady_start_step(p)
+        shared_model = RelativeMotionModel(
+            orbit_rate=np.array(p.orbit_rate, dtype=float),
+            disturbance_amplitude=np.array(p.disturbance_amplitude, dtype=float),
+            disturbance_frequency=np.array(p.disturbance_frequency, dtype=float),
+            disturbance_phase=np.zeros(3),
+        )
         # |r| stays inside the cavity (leaving it ends the episode), so |r - r(t_k)| < 2 R.
         feature_high = np.concatenate(
             [np.full(3, 2.0 * p.cavity_radius_m), np.full(3, p.cavity_radius_m), np.full(9, np.inf)]
@@ -81,148 +122,112 @@ class InnerFormationEnv(EventTriggeredEnv):
             feature_high=feature_high,
             n_channels=3,
             channel_width=1,
+            state_width=STATE_WIDTH,
+            constants=LoopConstants(
+                model=shared_model,
+                design=self.design,
+                cavity_radius=float(p.cavity_radius_m),
+                steady_start_step=self.steady_start_step,
+            ),
             sampling_period_s=p.sampling_period_s,
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
             failure_cost=p.cavity_radius_m,
         )
-        self.design = ObserverFeedback(
-            gain=np.array(p.observer_gain, dtype=float),
-            beta=np.array(p.observer_beta, dtype=float),
-            feedback=p.feedback_scale * np.array(p.feedback_gains, dtype=float),
-        )
-        self.steady_start_step = int(np.floor((1.0 - STEADY_FRACTION) * self.n_steps))
-        self.state = np.zeros(15)
-        self.control = np.zeros(3)
-        self._features_now = np.zeros(len(FEATURE_NAMES))
+
+    @property
+    def model(self) -> RelativeMotionModel:
+        """The relative-motion model of the current episode (with its disturbance phases)."""
+        return episode_model(self.state, self.constants)
 
     # ----------------------------------------------------------------- hooks
     def _reset_problem(self, options: dict[str, Any] | None) -> None:
         p = self.params
         rng = self.np_random
+        state = self.state
         if self.randomize:
             direction = rng.normal(size=3)
             position = (
                 direction / np.linalg.norm(direction) * rng.uniform(0.0, RANDOM_POSITION_MAX_M)
             )
             velocity = rng.uniform(-RANDOM_VELOCITY_MAX_MPS, RANDOM_VELOCITY_MAX_MPS, size=3)
-            phase = rng.uniform(0.0, 2.0 * np.pi, size=3)
+            state[DISTURBANCE_PHASE] = rng.uniform(0.0, 2.0 * np.pi, size=3)
         else:
             position = np.array(p.initial_position_m, dtype=float)
             velocity = np.array(p.initial_velocity_mps, dtype=float)
-            phase = np.array(p.disturbance_phase, dtype=float)
-        self.model = RelativeMotionModel(
-            orbit_rate=np.array(p.orbit_rate, dtype=float),
-            disturbance_amplitude=np.array(p.disturbance_amplitude, dtype=float),
-            disturbance_frequency=np.array(p.disturbance_frequency, dtype=float),
-            disturbance_phase=phase,
-        )
-        estimate = np.zeros(9)
+            state[DISTURBANCE_PHASE] = p.disturbance_phase
+        loop = state[LOOP]
+        loop[0:3] = position
+        loop[3:6] = velocity
         if p.observer_start == "first_measurement":
-            estimate[0:3] = position
-        self.state = np.concatenate([position, velocity, estimate])
-        self.control = np.zeros(3)
-        self._features_now = sensor_features(self.state, position)
-        self._counts_before = np.zeros(3, dtype=np.int64)
-        self._steady_max = np.zeros((3, 3))  # rows: |r - ζ|, |ṙ - ψ|, |h - φ|; columns: axes
-        self._steady_max_offset = 0.0  # ‖r‖
-        self._max_abs = np.zeros((3, 3))  # rows: |r_i|, |ṙ_i|, |ḣ_i|
-        self._max_sampling_error = np.zeros(3)
-        self._min_grown_error = np.full(3, np.inf)
-        self._accumulated = np.zeros(2)  # Σ ‖u‖ (m/s²), Σ cost
+            loop[6:9] = position
+        state[FEATURES] = sensor_features(loop, position)
+        state[RETRANSMIT_ERROR_MIN] = np.inf
 
-    def _channel_values(self) -> np.ndarray:
-        return self.state[0:3]
-
-    def _advance(self) -> float:
-        counts = self.channel.transmissions
-        sent_again = (counts > self._counts_before) & (self._counts_before > 0)
-        grown = np.abs(self._features_now[0:3])
-        self._min_grown_error = np.where(
-            sent_again, np.minimum(self._min_grown_error, grown), self._min_grown_error
-        )
-        self._counts_before = counts.copy()
-        held = self.channel.held[:, 0]
-        (
-            self.state,
-            self._features_now,
-            position_error,
-            velocity_error,
-            disturbance_error,
-            lumped_rate,
-            self.control,
-        ) = closed_loop_step(
-            self.time_s, self.sampling_period_s, self.state, held, self.model, self.design
-        )
-        sampling_error = np.abs(self._features_now[0:3])
-        np.maximum(self._max_sampling_error, sampling_error, out=self._max_sampling_error)
-        np.maximum(self._max_abs[0], np.abs(self.state[0:3]), out=self._max_abs[0])
-        np.maximum(self._max_abs[1], np.abs(self.state[3:6]), out=self._max_abs[1])
-        np.maximum(self._max_abs[2], np.abs(lumped_rate), out=self._max_abs[2])
-        if self.step_index + 1 > self.steady_start_step:
-            position = self.state[0:3]
-            errors = (position_error, velocity_error, disturbance_error)
-            np.maximum(self._steady_max, errors, out=self._steady_max)
-            self._steady_max_offset = max(self._steady_max_offset, np.sqrt(position @ position))
-        cost = np.abs(self.state[0:3]).sum() + position_error.sum()
-        self._accumulated += (np.sqrt(self.control @ self.control), cost)
-        return float(cost)
-
-    def _failure(self) -> str | None:
-        if not np.isfinite(self.state.sum()):
+    def _failure_message(self, code: int) -> str:
+        if code == NON_FINITE:
             return "non-finite state"
-        offset = float(np.sqrt(self.state[0:3] @ self.state[0:3]))
-        if offset > self.params.cavity_radius_m:
-            return (
-                f"collision: |r| = {offset:.3g} m > cavity_radius_m = {self.params.cavity_radius_m}"
-            )
-        return None
-
-    def _features(self) -> np.ndarray:
-        return self._features_now
+        offset = float(offset_norm(self.state))
+        radius = self.params.cavity_radius_m
+        return f"collision: |r| = {offset:.3g} m > cavity_radius_m = {radius}"
 
     def _paper_metrics(self) -> dict[str, Any]:
+        state = self.state
         steps = max(self.step_index, 1)
-        grown = np.where(np.isfinite(self._min_grown_error), self._min_grown_error, 0.0)
-        bounds = estimation_bounds(self.params, self._max_sampling_error)
+        steady = state[STEADY_ERROR_MAX].reshape(3, 3)  # rows: |r - ζ|, |ṙ - ψ|, |h - φ|
+        extremes = state[EXTREMES].reshape(3, 3)  # rows: |r_i|, |ṙ_i|, |ḣ_i|
+        sampling_error = state[SAMPLING_ERROR_MAX]
+        least = state[RETRANSMIT_ERROR_MIN]
+        grown = np.where(np.isfinite(least), least, 0.0)
+        bounds = estimation_bounds(self.params, sampling_error)
         per_axis_min = [
-            min(intervals) if intervals else None for intervals in self.channel.interevent_s
+            float(interval) if np.isfinite(interval) else None
+            for interval in self.arrays.interevent_min_s[0]
         ]
+        control_sum = state[CONTROL_NORM_SUM]
         return {
-            "ss_pos_est_err_m": float(self._steady_max[0].max()),
-            "ss_vel_est_err_mps": float(self._steady_max[1].max()),
-            "ss_dist_est_err_mps2": float(self._steady_max[2].max()),
-            "ss_pos_err_m": float(self._steady_max_offset),
-            "ss_pos_est_err_m_per_axis": self._steady_max[0].tolist(),
-            "ss_vel_est_err_mps_per_axis": self._steady_max[1].tolist(),
-            "ss_dist_est_err_mps2_per_axis": self._steady_max[2].tolist(),
-            "transmissions_per_axis": self.channel.transmissions.tolist(),
+            "ss_pos_est_err_m": float(steady[0].max()),
+            "ss_vel_est_err_mps": float(steady[1].max()),
+            "ss_dist_est_err_mps2": float(steady[2].max()),
+            "ss_pos_err_m": float(state[STEADY_OFFSET_MAX]),
+            "ss_pos_est_err_m_per_axis": steady[0].tolist(),
+            "ss_vel_est_err_mps_per_axis": steady[1].tolist(),
+            "ss_dist_est_err_mps2_per_axis": steady[2].tolist(),
+            "transmissions_per_axis": self.transmissions.tolist(),
             "min_interevent_s_per_axis": per_axis_min,
             "zeno_bound_s_per_axis": zeno_bound_s(
-                grown, np.maximum(self._max_abs[0], 1e-300), np.maximum(self._max_abs[1], 1e-300)
+                grown, np.maximum(extremes[0], 1e-300), np.maximum(extremes[1], 1e-300)
             ).tolist(),
-            "max_sampling_error_m_per_axis": self._max_sampling_error.tolist(),
+            "max_sampling_error_m_per_axis": sampling_error.tolist(),
             "bound_pos_est_m_per_axis": bounds["position_m"].tolist(),
             "bound_vel_est_mps_per_axis": bounds["velocity_mps"].tolist(),
             "bound_dist_est_mps2_per_axis": bounds["disturbance_mps2"].tolist(),
-            "max_lumped_rate_mps3_per_axis": self._max_abs[2].tolist(),
-            "mean_control_accel_mps2": float(self._accumulated[0] / steps),
-            "mean_thrust_n": float(self.params.mass_outer_kg * self._accumulated[0] / steps),
+            "max_lumped_rate_mps3_per_axis": extremes[2].tolist(),
+            "mean_control_accel_mps2": float(control_sum / steps),
+            "mean_thrust_n": float(self.params.mass_outer_kg * control_sum / steps),
         }
 
     # ----------------------------------------------------------------- diagnostics
     def state_dict(self) -> dict[str, np.ndarray]:
         """Named copies of the loop's signals at the current instant (for plots and tests)."""
         t = self.time_s
+        loop = self.state[LOOP]
         return {
             "time_s": np.array(t),
-            "position": self.state[0:3].copy(),
-            "velocity": self.state[3:6].copy(),
-            "position_estimate": self.state[6:9].copy(),
-            "velocity_estimate": self.state[9:12].copy(),
-            "disturbance_estimate": self.state[12:15].copy(),
-            "lumped_disturbance": lumped_term(t, self.state[0:3], self.state[3:6], self.model),
-            "held_position": self.channel.held[:, 0].copy(),
-            "control": self.control.copy(),
+            "position": loop[0:3].copy(),
+            "velocity": loop[3:6].copy(),
+            "position_estimate": loop[6:9].copy(),
+            "velocity_estimate": loop[9:12].copy(),
+            "disturbance_estimate": loop[12:15].copy(),
+            "lumped_disturbance": lumped_term(t, loop[0:3], loop[3:6], self.model),
+            "held_position": self.held[:, 0].copy(),
+            "control": self.state[CONTROL].copy(),
         }
+
+
+class InnerFormationVectorEnv(EventTriggeredVectorEnv):
+    """``num_envs`` :class:`InnerFormationEnv` stepped in one compiled call (the id's
+    ``vector_entry_point``)."""
+
+    single_env_class = InnerFormationEnv
