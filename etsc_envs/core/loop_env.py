@@ -30,6 +30,7 @@ from etsc_envs.core.compiled_loop import (
     LoopArrays,
     ProblemKernels,
     allocate_loop_arrays,
+    compiled_entry,
     interevent_summary,
     make_loop_step,
 )
@@ -121,6 +122,7 @@ class EventTriggeredEnv(gym.Env):
         """Live in ``arrays`` (one row, typically a view into a vector environment's batch)."""
         self.arrays = arrays
         self.state = arrays.state[0]
+        self._loop_step_entry = None
 
     # ----------------------------------------------------------------- problem hooks
     def _reset_problem(self, options: dict[str, Any] | None) -> None:
@@ -213,7 +215,7 @@ class EventTriggeredEnv(gym.Env):
         if arrays.failure_code[0] != 0 or arrays.step_index[0] >= self.n_steps:
             raise RuntimeError("step() called after the episode ended; call reset() first")
         self._actions[0] = self._transmit_bits(action)
-        self.loop_step(
+        arguments = (
             self._actions,
             self._active,
             arrays,
@@ -224,6 +226,9 @@ class EventTriggeredEnv(gym.Env):
             self.transmission_penalty,
             self.failure_cost,
         )
+        if self._loop_step_entry is None:
+            self._loop_step_entry = compiled_entry(self.loop_step, *arguments)
+        self._loop_step_entry(*arguments)
         terminated = bool(arrays.failure_code[0] != 0)
         truncated = bool(not terminated and arrays.step_index[0] >= self.n_steps)
         return (

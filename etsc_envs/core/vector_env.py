@@ -28,7 +28,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from etsc_envs.core.compiled_loop import allocate_loop_arrays, loop_rows
+from etsc_envs.core.compiled_loop import allocate_loop_arrays, compiled_entry, loop_rows
 from etsc_envs.core.loop_env import EventTriggeredEnv
 
 ROWS_PER_THREAD_MIN = 8
@@ -105,6 +105,7 @@ class EventTriggeredVectorEnv(VectorEnv):
         self._chunks = _row_chunks(self.num_envs, _worker_count(self.num_envs))
         self._pool = ThreadPoolExecutor(len(self._chunks)) if len(self._chunks) > 1 else None
         self._chunk_arrays = [loop_rows(self.arrays, *chunk) for chunk in self._chunks]
+        self._loop_step_entry = None
         self._actions = np.zeros((self.num_envs, first.n_channels), dtype=np.int64)
         self._needs_reset = np.ones(self.num_envs, dtype=bool)
 
@@ -189,9 +190,9 @@ class EventTriggeredVectorEnv(VectorEnv):
         """One compiled loop step of the ``active`` rows, each thread on its own row range."""
         first = self.envs[0]
 
-        def advance(chunk: int) -> None:
+        def arguments(chunk: int) -> tuple[Any, ...]:
             start, stop = self._chunks[chunk]
-            first.loop_step(
+            return (
                 self._actions[start:stop],
                 active[start:stop],
                 self._chunk_arrays[chunk],
@@ -202,6 +203,13 @@ class EventTriggeredVectorEnv(VectorEnv):
                 first.transmission_penalty,
                 first.failure_cost,
             )
+
+        if self._loop_step_entry is None:
+            self._loop_step_entry = compiled_entry(first.loop_step, *arguments(0))
+        entry = self._loop_step_entry
+
+        def advance(chunk: int) -> None:
+            entry(*arguments(chunk))
 
         if self._pool is None:
             advance(0)
