@@ -40,9 +40,9 @@ from etsc_envs.attitude_tracking.dynamics import (
 )
 from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
 from etsc_envs.core.loop_env import EventTriggeredEnv
-from etsc_envs.core.vector_env import EventTriggeredVectorEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector
 from etsc_envs.core.validation import apply_overrides
+from etsc_envs.core.vector_env import EventTriggeredVectorEnv
 
 FEATURE_NAMES = (
     "e1_x", "e1_y", "e1_z",

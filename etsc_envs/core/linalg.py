@@ -11,6 +11,15 @@ from etsc_envs.core.jit import jit
 
 
 @jit
+def dot(left: np.ndarray, right: np.ndarray) -> float:
+    """``left @ right`` for two vectors of the same length."""
+    total = 0.0
+    for i in range(left.shape[0]):
+        total += left[i] * right[i]
+    return total
+
+
+@jit
 def matvec(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
     """``matrix @ vector`` for an m×n matrix and an n-vector."""
     rows, columns = matrix.shape
