@@ -117,7 +117,9 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
     int array of transmit bits, ``active`` an ``(n,)`` bool array of the rows to advance (the
     others are left untouched), ``arrays`` a :class:`LoopArrays` of ``n`` rows. The kernels
     are bound at compile time rather than passed as arguments so that the machine code can be
-    cached on disk.
+    cached on disk. Every problem's step shares one cache index, which records the argument
+    types: a problem's ``constants`` must therefore be a namedtuple of an importable module (or
+    a plain tuple), or other processes fail to read the index.
     """
     channel_values = kernels.channel_values
     accepts = kernels.accepts
