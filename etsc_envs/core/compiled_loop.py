@@ -46,6 +46,9 @@ LoopArrays = namedtuple(
         "channel_costs",  # (n, C): each channel's accuracy cost of the last step
         "channel_rewards",  # (n, C): each channel's reward of the last step
         "reward",  # (n,): the last step's reward
+        "cost",  # (n,): the last step's accuracy cost (all channels)
+        "sent_count",  # (n,) int64: channels that transmitted in the last step
+        "transmission_count",  # (n,) int64: transmissions in the episode (all channels)
         "cost_sum",  # (n,): accuracy cost summed over the episode
         "failure_code",  # (n,) int64: 0, or why the episode ended (problem-specific)
         "observation",  # (n, F + C) float32: features, then time since each transmission
@@ -96,6 +99,9 @@ def allocate_loop_arrays(
         channel_costs=np.zeros((n_envs, n_channels)),
         channel_rewards=np.zeros((n_envs, n_channels)),
         reward=np.zeros(n_envs),
+        cost=np.zeros(n_envs),
+        sent_count=np.zeros(n_envs, dtype=np.int64),
+        transmission_count=np.zeros(n_envs, dtype=np.int64),
         cost_sum=np.zeros(n_envs),
         failure_code=np.zeros(n_envs, dtype=np.int64),
         observation=np.zeros((n_envs, n_features + n_channels), dtype=np.float32),
@@ -174,6 +180,9 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
             time_next = step_index * h
             for channel in range(n_channels):
                 observation[n_features + channel] = time_next - arrays.last_sent_s[i, channel]
+        arrays.cost[i] = cost
+        arrays.sent_count[i] = sent_total
+        arrays.transmission_count[i] += sent_total
         arrays.cost_sum[i] += cost
         arrays.reward[i] = -(cost + failure_charge) / cost_scale - transmission_penalty * sent_total
         share = failure_charge / n_channels

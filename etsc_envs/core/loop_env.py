@@ -191,18 +191,14 @@ class EventTriggeredEnv(gym.Env):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         arrays = self.arrays
-        for name in ("step_index", "last_sent_s", "transmissions", "interevent_sum_s", "sent"):
-            getattr(arrays, name)[0] = 0
-        for name in ("channel_costs", "channel_rewards", "reward", "cost_sum", "failure_code"):
-            getattr(arrays, name)[0] = 0
+        for array in arrays:  # the state row included: _reset_problem starts from zeros
+            array[0] = 0
         arrays.interevent_min_s[0] = np.inf
-        self.state[:] = 0.0
         self._reset_problem(options)
         arrays.held[0] = self._initial_held()
         features = np.empty(self.n_features)
         self.kernels.features(self.state, self.constants, features)
         arrays.observation[0, : self.n_features] = features
-        arrays.observation[0, self.n_features :] = 0.0
         return arrays.observation[0].copy(), self.reset_info()
 
     @staticmethod
@@ -214,7 +210,7 @@ class EventTriggeredEnv(gym.Env):
         arrays = self.arrays
         if arrays.failure_code[0] != 0 or arrays.step_index[0] >= self.n_steps:
             raise RuntimeError("step() called after the episode ended; call reset() first")
-        self._actions[0] = self._transmit_bits(action)
+        self._set_transmit_bits(action)
         arguments = (
             self._actions,
             self._active,
@@ -244,10 +240,10 @@ class EventTriggeredEnv(gym.Env):
         the episode)."""
         arrays = self.arrays
         info: dict[str, Any] = {
-            "transmitted": int(arrays.sent[0].sum()),
-            "transmissions": int(arrays.transmissions[0].sum()),
+            "transmitted": int(arrays.sent_count[0]),
+            "transmissions": int(arrays.transmission_count[0]),
             "time_s": self.time_s,
-            "cost": float(arrays.channel_costs[0].sum()),
+            "cost": float(arrays.cost[0]),
         }
         if ended:
             failure = self.failure
@@ -284,11 +280,14 @@ class EventTriggeredEnv(gym.Env):
         return record
 
     # ----------------------------------------------------------------- internals
-    def _transmit_bits(self, action: Any) -> np.ndarray:
-        """The action as one 0/1 per channel, or ``ValueError`` naming what is allowed."""
+    def _set_transmit_bits(self, action: Any) -> None:
+        """Store the action as one 0/1 per channel, or ``ValueError`` naming what is allowed."""
+        if self.n_channels == 1 and isinstance(action, int | np.integer) and action in (0, 1):
+            self._actions[0, 0] = action  # the common case, without array checks
+            return
         bits = np.asarray(action)
         n_channels = self.n_channels
         if bits.size != n_channels or not np.all((bits == 0) | (bits == 1)):
             allowed = "0 (hold) or 1 (transmit)" if n_channels == 1 else f"{n_channels} bits of 0/1"
             raise ValueError(f"action must be {allowed}, got {action!r}")
-        return bits.reshape(n_channels)
+        self._actions[0] = bits.reshape(n_channels)

@@ -223,10 +223,10 @@ class EventTriggeredVectorEnv(VectorEnv):
         arrays = self.arrays
         present = np.ones(self.num_envs, dtype=bool)
         values = {
-            "transmitted": arrays.sent.sum(axis=1),
-            "transmissions": arrays.transmissions.sum(axis=1),
+            "transmitted": arrays.sent_count.copy(),
+            "transmissions": arrays.transmission_count.copy(),
             "time_s": arrays.step_index * self.envs[0].sampling_period_s,
-            "cost": arrays.channel_costs.sum(axis=1),
+            "cost": arrays.cost.copy(),
         }
         infos: dict[str, np.ndarray] = {}
         for key, value in values.items():
