@@ -20,6 +20,9 @@ VECTOR_ENTRY_POINTS = {
     "etsc/AttitudeTracking-v0": "etsc_envs.attitude_tracking.env:AttitudeTrackingVectorEnv",
     "etsc/InnerFormation-v0": "etsc_envs.inner_formation.env:InnerFormationVectorEnv",
     "etsc/AsteroidOrbitKeeping-v0": "etsc_envs.asteroid.env:AsteroidOrbitKeepingVectorEnv",
+    "etsc/ClusterContainmentCentral-v0": (
+        "etsc_envs.cluster.env:ClusterContainmentCentralVectorEnv"
+    ),
 }
 """Gymnasium id → its native vector environment, for ``gym.make_vec(id, num_envs=n,
 vectorization_mode="vector_entry_point")`` (all sub-environments stepped in one compiled call)."""

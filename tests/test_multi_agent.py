@@ -1,7 +1,8 @@
 """The PettingZoo view of a shared multi-channel loop, :mod:`etsc_envs.core.multi_agent`.
 
-Checked on a toy loop of two independent scalar integrators (channel i holds the control of
-integrator i, which drifts away unless updated), so every number is known by hand:
+Checked on a toy compiled loop of independent scalar integrators (two unless said otherwise;
+channel i holds the control of integrator i, which drifts away unless updated), so every
+number is known by hand:
 
 * each agent observes its own feature block and its own transmission clock, with bounds taken
   from the loop's observation space; ``state()`` is the loop's whole observation;
@@ -19,8 +20,9 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from pettingzoo.test import parallel_api_test
 
-from etsc_envs.core.channel import HeldChannel
-from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts
+from etsc_envs.core.jit import jit
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.multi_agent import (
     EventTriggeredParallelEnv,
     agent_major_names,
@@ -29,58 +31,99 @@ from etsc_envs.core.multi_agent import (
 
 DRIFT = 1.0
 PERIOD_S = 0.1
+RUNAWAY = 1
+LIMIT = 0
+"""Index of the failure bound in the toy's constants, a plain tuple ``(limit,)``: the disk
+cache's index of the shared loop step records the constants' type, and a namedtuple class of
+this test module could not be unpickled by a process that never imported it."""
 
 
-class TwoIntegrators(EventTriggeredEnv):
+@jit
+def toy_channel_values(state, constants, time_s):
+    """The one-step law of every integrator, u_i = DRIFT + x_i / PERIOD_S."""
+    n = state.shape[0] // 2
+    return (DRIFT + state[:n] / PERIOD_S).reshape(n, 1)
+
+
+@jit
+def toy_advance(state, constants, step_index, h, held, sent, channel_costs):
+    """x_i += h (DRIFT - u_i) with u_i held (kept in the state row for the features)."""
+    n = state.shape[0] // 2
+    for i in range(n):
+        state[n + i] = held[i, 0]
+        state[i] += h * (DRIFT - held[i, 0])
+        channel_costs[i] = abs(state[i])
+
+
+@jit
+def toy_failure(state, constants):
+    n = state.shape[0] // 2
+    return RUNAWAY if np.abs(state[:n]).max() > constants[LIMIT] else 0
+
+
+@jit
+def toy_features(state, constants, out):
+    n = state.shape[0] // 2
+    for i in range(n):
+        out[2 * i] = state[i]
+        out[2 * i + 1] = state[n + i]
+
+
+class Integrators(EventTriggeredEnv):
     """ẋ_i = DRIFT - u_i with u_i held; an update sets u_i = DRIFT + x_i / PERIOD_S, which brings
-    x_i back to 0 in one period. Cost_i = |x_i|; failure when |x_i| > ``limit``."""
+    x_i back to 0 in one period. Cost_i = |x_i|; failure when |x_i| > ``limit``. The state row
+    is ``[x_0 .. x_{n-1}, u_0 .. u_{n-1}]``."""
 
-    def __init__(self, limit: float = 10.0, names: tuple[str, ...] | None = None) -> None:
-        self.agent_names = ("integrator_0", "integrator_1")
+    kernels = ProblemKernels(
+        channel_values=toy_channel_values,
+        accepts=always_accepts,
+        advance=toy_advance,
+        failure=toy_failure,
+        features=toy_features,
+    )
+
+    def __init__(
+        self,
+        limit: float = 10.0,
+        names: tuple[str, ...] | None = None,
+        n_integrators: int = 2,
+        horizon_s: float = 1.0,
+    ) -> None:
+        self.agent_names = tuple(f"integrator_{i}" for i in range(n_integrators))
         self.agent_feature_names = ("x", "u")
         super().__init__(
-            feature_names=names or agent_major_names(self.agent_feature_names, 2),
-            feature_low=np.array([-limit, -np.inf, -limit, -np.inf]),
-            feature_high=np.array([limit, np.inf, limit, np.inf]),
-            n_channels=2,
+            feature_names=names or agent_major_names(self.agent_feature_names, n_integrators),
+            feature_low=np.tile([-limit, -np.inf], n_integrators),
+            feature_high=np.tile([limit, np.inf], n_integrators),
+            n_channels=n_integrators,
             channel_width=1,
+            state_width=2 * n_integrators,
+            constants=(float(limit),),
             sampling_period_s=PERIOD_S,
-            horizon_s=1.0,
+            horizon_s=horizon_s,
             transmission_penalty=0.5,
             cost_scale=2.0,
             failure_cost=3.0,
         )
-        self.limit = limit
-        self.x = np.zeros(2)
-        self.channel_costs = np.zeros(2)
 
     def _reset_problem(self, options):
-        self.x = np.array([0.2, 0.5])
+        n = self.n_channels
+        self.state[:n] = np.linspace(0.2, 0.5, n)
+        self.state[n:] = toy_channel_values(self.state, self.constants, 0.0)[:, 0]
 
-    def _channel_values(self):
-        return DRIFT + self.x / PERIOD_S
-
-    def _advance(self):
-        self.x = self.x + PERIOD_S * (DRIFT - self.channel.held[:, 0])
-        self.channel_costs = np.abs(self.x)
-        return float(self.channel_costs.sum())
-
-    def _failure(self):
-        return "runaway" if np.abs(self.x).max() > self.limit else None
-
-    def _features(self):
-        return np.array([self.x[0], self.channel.held[0, 0], self.x[1], self.channel.held[1, 0]])
+    def _failure_message(self, code):
+        return "runaway"
 
     def _paper_metrics(self):
-        return {"agents": agent_metrics(self.channel, self.step_index, self.agent_names)}
+        return {"agents": agent_metrics(self.arrays, self.step_index, self.agent_names)}
 
 
 def test_passes_the_pettingzoo_parallel_api_test():
-    parallel_api_test(EventTriggeredParallelEnv(TwoIntegrators()), num_cycles=50)
+    parallel_api_test(EventTriggeredParallelEnv(Integrators()), num_cycles=50)
 
 
 def test_observations_rewards_and_clocks_per_agent():
-    env = EventTriggeredParallelEnv(TwoIntegrators())
+    env = EventTriggeredParallelEnv(Integrators())
     assert env.agent_observation_names == ("x", "u", "time_since_transmission_s")
     assert_array_equal(env.observation_space("integrator_1").low, [-10.0, -np.inf, 0.0])
     observations, infos = env.reset(seed=0)
@@ -100,7 +143,7 @@ def test_observations_rewards_and_clocks_per_agent():
 
 
 def test_truncation_ends_every_agent_with_per_agent_metrics():
-    env = EventTriggeredParallelEnv(TwoIntegrators())
+    env = EventTriggeredParallelEnv(Integrators())
     env.reset(seed=0)
     bits = [(1, 0), (0, 0), (1, 1), (0, 0), (1, 0), (0, 0), (0, 0), (0, 0), (0, 0), (0, 0)]
     for k, (a, b) in enumerate(bits):
@@ -119,9 +162,9 @@ def test_truncation_ends_every_agent_with_per_agent_metrics():
 
 
 def test_failure_terminates_all_and_rewards_sum_to_the_loop_reward():
-    loop = TwoIntegrators(limit=0.75)
+    loop = Integrators(limit=0.75)
     env = EventTriggeredParallelEnv(loop)
-    twin = TwoIntegrators(limit=0.75)
+    twin = Integrators(limit=0.75)
     env.reset(seed=0)
     twin.reset(seed=0)
     while env.agents:
@@ -137,7 +180,7 @@ def test_failure_terminates_all_and_rewards_sum_to_the_loop_reward():
 
 def test_loop_breaking_the_naming_contract_is_rejected():
     with pytest.raises(ValueError, match="agent_major_names"):
-        EventTriggeredParallelEnv(TwoIntegrators(names=("a", "b", "c", "d")))
+        EventTriggeredParallelEnv(Integrators(names=("a", "b", "c", "d")))
 
 
 @pytest.mark.parametrize(
@@ -150,18 +193,19 @@ def test_loop_breaking_the_naming_contract_is_rejected():
     ],
 )
 def test_bad_actions_are_rejected(actions, message):
-    env = EventTriggeredParallelEnv(TwoIntegrators())
+    env = EventTriggeredParallelEnv(Integrators())
     env.reset(seed=0)
     with pytest.raises(ValueError, match=message):
         env.step(actions)
 
 
 def test_agent_metrics_count_each_channel():
-    channel = HeldChannel(3, 1)
-    channel.reset(np.zeros(3), 0.0)
-    for t, mask in ((0.0, [1, 0, 0]), (0.5, [1, 1, 0]), (2.0, [1, 0, 0])):
-        channel.send(np.array(mask, dtype=bool), np.ones(3), t)
-    record = agent_metrics(channel, 40, ("a", "b", "c"))
+    loop = Integrators(limit=1e9, n_integrators=3, horizon_s=4.0)
+    loop.reset(seed=0)
+    sends = {0: [1, 0, 0], 5: [1, 1, 0], 20: [1, 0, 0]}  # at 0.0 s, 0.5 s and 2.0 s
+    for k in range(40):
+        loop.step(np.array(sends.get(k, [0, 0, 0])))
+    record = agent_metrics(loop.arrays, 40, ("a", "b", "c"))
     assert record["a"] == {
         "transmissions": 3,
         "transmission_rate": 3 / 40,

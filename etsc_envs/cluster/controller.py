@@ -32,17 +32,19 @@ def reference_rates(sigma: np.ndarray, sigma_dot: np.ndarray, model: ClusterMode
     sigma_r_dot = np.zeros((n, 3))
     sigma_r_ddot = np.zeros((n, 3))
     adjacency = model.adjacency
+    leaders = model.leader_attitudes
     for i in range(n):
         for j in range(adjacency.shape[1]):
             weight = adjacency[i, j]
             if weight == 0.0:
                 continue
-            if j < n:
-                sigma_r_dot[i] -= weight * (sigma[i] - sigma[j])
-                sigma_r_ddot[i] -= weight * (sigma_dot[i] - sigma_dot[j])
-            else:
-                sigma_r_dot[i] -= weight * (sigma[i] - model.leader_attitudes[j - n])
-                sigma_r_ddot[i] -= weight * sigma_dot[i]
+            for axis in range(3):  # component by component: no temporary arrays
+                if j < n:
+                    sigma_r_dot[i, axis] -= weight * (sigma[i, axis] - sigma[j, axis])
+                    sigma_r_ddot[i, axis] -= weight * (sigma_dot[i, axis] - sigma_dot[j, axis])
+                else:
+                    sigma_r_dot[i, axis] -= weight * (sigma[i, axis] - leaders[j - n, axis])
+                    sigma_r_ddot[i, axis] -= weight * sigma_dot[i, axis]
     return model.alpha * sigma_r_dot, model.alpha * sigma_r_ddot
 
 

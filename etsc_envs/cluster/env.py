@@ -15,19 +15,36 @@ import numpy as np
 from scipy.optimize import nnls
 
 from etsc_envs.cluster.closed_loop import (
+    CONVERGENCE_FRACTION,
+    CONVERGENCE_THRESHOLD,
+    DISTURBANCE_PHASE,
+    FEATURES,
+    KERNELS,
+    LAST_FAST_STEP,
+    LAST_OUTSIDE_STEP,
+    MIN_CONVERGENCE_THRESHOLD,
     N_FEATURES,
+    NON_FINITE,
+    NORMS,
+    PLANT,
+    SAMPLE,
     SAMPLE_WIDTH,
-    STATE_WIDTH,
+    LoopConstants,
     agent_features,
-    closed_loop_step,
+    episode_model,
     event_samples,
     follower_signals,
+    follower_table,
+    note_outside_followers,
+    note_peak_rate,
+    state_width,
 )
 from etsc_envs.cluster.dynamics import ClusterModel
 from etsc_envs.cluster.params import ClusterContainmentParams, replace_params
 from etsc_envs.cluster.topology import containment_targets
-from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.multi_agent import agent_major_names, agent_metrics
+from etsc_envs.core.vector_env import EventTriggeredVectorEnv
 
 FEATURE_NAMES = (
     "event_error",
@@ -59,8 +76,6 @@ FEATURE_NAMES = (
 PERIODIC_TERMS = 4
 RANDOM_ATTITUDE_MAX_NORM = 0.6
 RANDOM_RATE_MAX_RAD_S = 0.015
-CONVERGENCE_FRACTION = 0.05
-MIN_CONVERGENCE_THRESHOLD = 1e-6
 
 
 def cluster_model(params: ClusterContainmentParams, disturbance_phase: np.ndarray) -> ClusterModel:
@@ -119,6 +134,8 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
     index, then ``time_since_transmission_s_i`` for every follower.
     """
 
+    kernels = KERNELS
+
     def __init__(
         self,
         params: ClusterContainmentParams | None = None,
@@ -143,22 +160,28 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
             feature_high=np.tile(high, n),
             n_channels=n,
             channel_width=SAMPLE_WIDTH,
+            state_width=state_width(n),
+            constants=LoopConstants(
+                model=cluster_model(p, np.zeros((n, PERIODIC_TERMS))),
+                limits=np.array([p.max_mrp_norm, p.max_rate_rad_s]),
+            ),
             sampling_period_s=p.sampling_period_s,
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
             failure_cost=n * error_bound,
         )
-        self.model = cluster_model(p, np.zeros((n, PERIODIC_TERMS)))
-        self.loop_state = np.zeros((n, STATE_WIDTH))
-        self.samples = np.zeros((n, SAMPLE_WIDTH))
-        self.channel_costs = np.zeros(n)
-        self.norms = np.zeros((n, 2))
-        self._features_now = np.zeros((n, N_FEATURES))
-        self._thresholds = np.zeros(n)
-        self._last_outside = np.zeros(n, dtype=np.int64)
-        self._peak_rate = np.zeros(self.n_steps + 1)
-        self._limits = np.array([p.max_mrp_norm, p.max_rate_rad_s])
+
+    @property
+    def followers(self) -> np.ndarray:
+        """The followers' records of the state row, N×``FOLLOWER_WIDTH`` (see
+        :mod:`etsc_envs.cluster.closed_loop` for the layout)."""
+        return follower_table(self.state)
+
+    @property
+    def model(self) -> ClusterModel:
+        """The cluster model of the current episode (with its disturbance phases)."""
+        return episode_model(self.state, self.constants)
 
     def _feature_bounds(self, error_bound: float) -> tuple[np.ndarray, np.ndarray]:
         """Bounds of one follower's features: the failure bounds limit σ, ω and the error."""
@@ -181,79 +204,67 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
         p = self.params
         n = p.n_followers
         rng = self.np_random
+        followers = self.followers
         if self.randomize:
             directions = rng.normal(size=(n, 3))
             directions /= np.linalg.norm(directions, axis=1, keepdims=True)
             radii = RANDOM_ATTITUDE_MAX_NORM * rng.uniform(0.0, 1.0, size=(n, 1)) ** (1.0 / 3.0)
             attitudes = radii * directions
             rates = rng.uniform(-RANDOM_RATE_MAX_RAD_S, RANDOM_RATE_MAX_RAD_S, size=(n, 3))
-            phases = rng.uniform(0.0, 2.0 * np.pi, size=(n, PERIODIC_TERMS))
+            followers[:, DISTURBANCE_PHASE] = rng.uniform(
+                0.0, 2.0 * np.pi, size=(n, PERIODIC_TERMS)
+            )
         else:
             attitudes = np.array(p.initial_attitudes, dtype=float)
             rates = np.array(p.initial_rates, dtype=float)
-            phases = np.zeros((n, PERIODIC_TERMS))
-        self.model = self.model._replace(disturbance_phase=phases)
-        state = np.empty((n, STATE_WIDTH))
-        state[:, 0:3] = attitudes
-        state[:, 3:6] = rates
-        state[:, 6:12] = np.array(p.initial_parameter_estimate, dtype=float)
-        state[:, 12] = p.initial_switching_gain
-        self.loop_state = state
-        self.samples = event_samples(state, self.model)
-        self._features_now = agent_features(0.0, state, self.samples, self.samples, self.model)
-        errors = np.linalg.norm(attitudes - self.targets, axis=1)
-        self.channel_costs = np.zeros(n)
-        self.norms = np.stack(
+        y = followers[:, PLANT]
+        y[:, 0:3] = attitudes
+        y[:, 3:6] = rates
+        y[:, 6:12] = np.array(p.initial_parameter_estimate, dtype=float)
+        y[:, 12] = p.initial_switching_gain
+        model = self.model
+        samples = event_samples(y, model)
+        followers[:, SAMPLE] = samples
+        followers[:, FEATURES] = agent_features(0.0, y, samples, samples, model)
+        followers[:, NORMS] = np.stack(
             [np.linalg.norm(attitudes, axis=1), np.linalg.norm(rates, axis=1)], axis=1
         )
-        self._thresholds = np.maximum(CONVERGENCE_FRACTION * errors, MIN_CONVERGENCE_THRESHOLD)
-        self._last_outside = np.where(errors > self._thresholds, 0, -1)
-        self._peak_rate[:] = 0.0
-        self._peak_rate[0] = self.norms[:, 1].max()
+        self._start_convergence_bookkeeping(np.linalg.norm(attitudes - self.targets, axis=1))
 
-    def _channel_values(self) -> np.ndarray:
-        return self.samples
-
-    def _advance(self) -> float:
-        (
-            self.loop_state,
-            self.samples,
-            self._features_now,
-            self.channel_costs,
-            self.norms,
-        ) = closed_loop_step(
-            self.time_s, self.sampling_period_s, self.loop_state, self.channel.held, self.model
+    def _start_convergence_bookkeeping(self, errors: np.ndarray) -> None:
+        """Thresholds of the convergence times from the initial errors, and step 0 noted."""
+        followers = self.followers
+        followers[:, CONVERGENCE_THRESHOLD] = np.maximum(
+            CONVERGENCE_FRACTION * errors, MIN_CONVERGENCE_THRESHOLD
         )
-        step = self.step_index + 1
-        self._last_outside[self.channel_costs > self._thresholds] = step
-        self._peak_rate[step] = self.norms[:, 1].max()
-        return float(self.channel_costs.sum())
+        followers[:, LAST_OUTSIDE_STEP] = -1.0
+        self.state[LAST_FAST_STEP] = -1.0
+        note_outside_followers(followers, errors, 0)
+        note_peak_rate(self.state, followers[:, NORMS][:, 1].max(), 0)
 
-    def _failure(self) -> str | None:
-        if not np.isfinite(self.loop_state.sum() + self.samples.sum()):
+    def _failure_message(self, code: int) -> str:
+        if code == NON_FINITE:
             return "non-finite state"
-        limits = self._limits
-        if np.all(self.norms <= limits):
-            return None
-        worst, column = np.unravel_index(np.argmax(self.norms / limits), self.norms.shape)
+        norms = self.followers[:, NORMS]
+        limits = self.constants.limits
+        worst, column = np.unravel_index(np.argmax(norms / limits), norms.shape)
         name, bound, unit = (
             ("sigma", "max_mrp_norm", "") if column == 0 else ("omega", "max_rate_rad_s", " rad/s")
         )
         return (
-            f"diverged: |{name}| of {self.agent_names[worst]} = {self.norms[worst, column]:.3g}"
+            f"diverged: |{name}| of {self.agent_names[worst]} = {norms[worst, column]:.3g}"
             f"{unit} > {bound} = {limits[column]}"
         )
 
-    def _features(self) -> np.ndarray:
-        return self._features_now.reshape(-1)
-
     def _paper_metrics(self) -> dict[str, Any]:
         h, steps = self.sampling_period_s, self.step_index
-        inside_since = (self._last_outside + 1) * h
-        converged = self._last_outside < steps
-        sigma = self.loop_state[:, 0:3]
+        followers = self.followers
+        last_outside = followers[:, LAST_OUTSIDE_STEP]
+        inside_since = (last_outside + 1) * h
+        converged = last_outside < steps
+        sigma = followers[:, 0:3]
         errors = np.linalg.norm(sigma - self.targets, axis=1)
-        agents = agent_metrics(self.channel, steps, self.agent_names)
+        agents = agent_metrics(self.arrays, steps, self.agent_names)
         for i, name in enumerate(self.agent_names):
             agents[name].update(
                 final_sigma=sigma[i].tolist(),
@@ -273,9 +284,7 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
 
     def _omega_converge_time(self) -> float | None:
         """First time after which every ‖ω_i‖ stays below 5 % of the episode's peak."""
-        peaks = self._peak_rate[: self.step_index + 1]
-        outside = np.flatnonzero(peaks > CONVERGENCE_FRACTION * peaks.max())
-        last = int(outside[-1]) if len(outside) else -1
+        last = int(self.state[LAST_FAST_STEP])
         if last >= self.step_index:
             return None
         return (last + 1) * self.sampling_period_s
@@ -283,23 +292,26 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
     # ----------------------------------------------------------------- diagnostics
     def state_dict(self) -> dict[str, np.ndarray]:
         """Named copies of the loop's signals at the current instant (for plots and tests)."""
-        state = self.loop_state
-        sigma_dot, s, regressors = follower_signals(state, self.model)
-        features = self._features_now
+        followers = self.followers
+        y = np.ascontiguousarray(followers[:, PLANT])
+        sigma_dot, s, regressors = follower_signals(y, self.model)
+        samples = followers[:, SAMPLE]
+        features = followers[:, FEATURES]
+        held = self.held
         return {
             "time_s": np.array(self.time_s),
-            "sigma": state[:, 0:3].copy(),
-            "omega": state[:, 3:6].copy(),
+            "sigma": y[:, 0:3].copy(),
+            "omega": y[:, 3:6].copy(),
             "sigma_dot": sigma_dot,
-            "theta_hat": state[:, 6:12].copy(),
-            "k_hat": state[:, 12].copy(),
+            "theta_hat": y[:, 6:12].copy(),
+            "k_hat": y[:, 12].copy(),
             "s": s,
             "regressor": regressors,
-            "y_theta": self.samples[:, 6:9].copy(),
-            "u": self.channel.held[:, 0:3].copy(),
-            "u_now": self.samples[:, 0:3].copy(),
-            "s_event": self.channel.held[:, 3:6].copy(),
-            "y_theta_event": self.channel.held[:, 6:9].copy(),
+            "y_theta": samples[:, 6:9].copy(),
+            "u": held[:, 0:3].copy(),
+            "u_now": samples[:, 0:3].copy(),
+            "s_event": held[:, 3:6].copy(),
+            "y_theta_event": held[:, 6:9].copy(),
             "e_J_norm": features[:, 2].copy(),
             "e_s_norm": features[:, 3].copy(),
             "event_error": features[:, 0].copy(),
@@ -307,5 +319,12 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
             "sqrt_lambda_min_K": features[:, 5].copy(),
             "targets": self.targets.copy(),
             "leaders": np.array(self.params.leader_attitudes, dtype=float),
-            "containment_error": np.linalg.norm(state[:, 0:3] - self.targets, axis=1),
+            "containment_error": np.linalg.norm(y[:, 0:3] - self.targets, axis=1),
         }
+
+
+class ClusterContainmentCentralVectorEnv(EventTriggeredVectorEnv):
+    """``num_envs`` :class:`ClusterContainmentCentralEnv` stepped in one compiled call (the
+    id's ``vector_entry_point``)."""
+
+    single_env_class = ClusterContainmentCentralEnv

@@ -1,23 +1,24 @@
 """PettingZoo view of a multi-channel event-triggered loop: one agent per channel.
 
 A problem whose paper triggers several channels separately (one per spacecraft of a
-formation, say) writes its closed loop once, as an :class:`~etsc_envs.core.loop.EventTriggeredEnv`
-with ``n_channels = N`` (a ``MultiBinary(N)`` Gymnasium env for a central trigger), and gets
-the decentralised multi-agent form from :class:`EventTriggeredParallelEnv`, which shares that
-loop: the agents' transmit bits are gathered into the loop's action, each agent observes its
-own block of the loop's observation plus its own transmission clock, and pays its own cost.
+formation, say) writes its closed loop once, as an
+:class:`~etsc_envs.core.loop_env.EventTriggeredEnv` with ``n_channels = N`` (a
+``MultiBinary(N)`` Gymnasium env for a central trigger), and gets the decentralised
+multi-agent form from :class:`EventTriggeredParallelEnv`, which shares that loop: the agents'
+transmit bits are gathered into the loop's action, each agent observes its own block of the
+loop's observation plus its own transmission clock, and is paid its own channel's reward.
 
 What the loop must provide (besides the :class:`EventTriggeredEnv` API):
 
 * ``agent_names``: one name per channel, in channel order;
 * ``agent_feature_names``: the names of one agent's features; the loop's observation starts
-  with every agent's features, agent after agent, named by :func:`agent_major_names`;
-* ``channel_costs``: each channel's share of the last step's cost (they sum to the cost).
+  with every agent's features, agent after agent, named by :func:`agent_major_names`.
 
-Per agent, the reward is ``-(cost_i + failure share)/cost_scale - transmission_penalty *
-sent_i``, where ``sent_i`` counts a transmission the loop accepted and a failure charges each
-agent ``failure_cost / N`` per step cut from the horizon, so the agents' rewards always sum to
-the central env's reward.
+The compiled step already splits every step by channel (:mod:`etsc_envs.core.compiled_loop`):
+agent i's reward is ``-(cost_i + failure share)/cost_scale - transmission_penalty * sent_i``,
+where ``sent_i`` counts a transmission the loop accepted and a failure charges each agent
+``failure_cost / N`` per step cut from the horizon, so the agents' rewards always sum to the
+central env's reward.
 """
 
 from __future__ import annotations
@@ -28,9 +29,8 @@ import gymnasium as gym
 import numpy as np
 from pettingzoo import ParallelEnv
 
-from etsc_envs.core.channel import HeldChannel
-from etsc_envs.core.loop import EventTriggeredEnv
-from etsc_envs.core.metrics import interevent_summary
+from etsc_envs.core.compiled_loop import LoopArrays, interevent_summary
+from etsc_envs.core.loop_env import EventTriggeredEnv
 
 CLOCK_NAME = "time_since_transmission_s"
 
@@ -41,14 +41,17 @@ def agent_major_names(feature_names: tuple[str, ...], n_agents: int) -> tuple[st
 
 
 def agent_metrics(
-    channel: HeldChannel, steps: int, agent_names: tuple[str, ...]
+    arrays: LoopArrays, steps: int, agent_names: tuple[str, ...]
 ) -> dict[str, dict[str, Any]]:
-    """Communication record of each agent's channel: ``transmissions``, ``transmission_rate``
-    (per sampling instant), ``mean_interevent_s`` and ``min_interevent_s``."""
+    """Communication record of each agent's channel in the loop ``arrays`` (one row):
+    ``transmissions``, ``transmission_rate`` (per sampling instant), ``mean_interevent_s``
+    and ``min_interevent_s``."""
     record = {}
     for index, name in enumerate(agent_names):
-        mean_s, min_s = interevent_summary(channel.interevent_s[index])
-        transmissions = int(channel.transmissions[index])
+        transmissions = int(arrays.transmissions[0, index])
+        mean_s, min_s = interevent_summary(
+            transmissions, arrays.interevent_sum_s[0, index], arrays.interevent_min_s[0, index]
+        )
         record[name] = {
             "transmissions": transmissions,
             "transmission_rate": transmissions / steps if steps else 0.0,
@@ -79,7 +82,7 @@ class EventTriggeredParallelEnv(ParallelEnv):
 
     def __init__(self, loop: EventTriggeredEnv) -> None:
         self.loop = loop
-        n_agents = loop.channel.n_channels
+        n_agents = loop.n_channels
         feature_names = tuple(loop.agent_feature_names)
         n_features = len(feature_names)
         if len(loop.agent_names) != n_agents:
@@ -125,10 +128,7 @@ class EventTriggeredParallelEnv(ParallelEnv):
     ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
         observation, _ = self.loop.reset(seed=seed, options=options)
         self.agents = list(self.possible_agents)
-        infos = {
-            agent: {"transmitted": 0, "transmissions": 0, "time_s": 0.0, "cost": 0.0}
-            for agent in self.agents
-        }
+        infos = {agent: self.loop.reset_info() for agent in self.agents}
         return self._split(observation), infos
 
     def step(self, actions: dict[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
@@ -136,25 +136,19 @@ class EventTriggeredParallelEnv(ParallelEnv):
             raise RuntimeError("step() called after the episode ended; call reset() first")
         bits = self._bits(actions)
         loop = self.loop
-        before = loop.channel.transmissions.copy()
         observation, _, terminated, truncated, info = loop.step(bits)
-        sent = loop.channel.transmissions - before  # the loop may refuse a request
-        costs = np.asarray(loop.channel_costs, dtype=float)
-        if not np.isfinite(costs.sum()):  # as the loop does: a non-finite step costs nothing
-            costs = np.zeros_like(costs)
-        step_costs = costs
-        if terminated:
-            costs = costs + loop.failure_cost / len(sent) * (loop.n_steps - loop.step_index)
-        rewards = -costs / loop.cost_scale - loop.transmission_penalty * sent
+        sent = loop.arrays.sent[0]
+        costs = loop.channel_costs
+        rewards = loop.channel_rewards
         observations = self._split(observation)
         names = self.possible_agents
         infos = {}
         for i, agent in enumerate(names):
             agent_info = {
                 "transmitted": int(sent[i]),
-                "transmissions": int(loop.channel.transmissions[i]),
+                "transmissions": int(loop.transmissions[i]),
                 "time_s": info["time_s"],
-                "cost": float(step_costs[i]),
+                "cost": float(costs[i]),
             }
             for key in ("failure", "episode_metrics"):
                 if key in info:
