@@ -214,9 +214,10 @@ class EventTriggeredVectorEnv(VectorEnv):
         if self._pool is None:
             advance(0)
         else:
-            for future in [self._pool.submit(advance, c) for c in range(1, len(self._chunks))]:
-                future.result()
+            others = [self._pool.submit(advance, c) for c in range(1, len(self._chunks))]
             advance(0)
+            for future in others:
+                future.result()
 
     def _step_infos(self) -> dict[str, np.ndarray]:
         """The per-step info keys of every sub-environment, batched (all present)."""
