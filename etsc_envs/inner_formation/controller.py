@@ -45,6 +45,9 @@ def control_law(estimate: np.ndarray, design: ObserverFeedback) -> np.ndarray:
     """
     control = np.empty(3)
     for axis in range(3):
-        axis_estimate = np.array([estimate[axis], estimate[3 + axis], estimate[6 + axis]])
-        control[axis] = -(design.feedback[axis] @ axis_estimate) - estimate[6 + axis]
+        row = design.feedback[axis]
+        feedback = (
+            row[0] * estimate[axis] + row[1] * estimate[3 + axis] + row[2] * estimate[6 + axis]
+        )
+        control[axis] = -feedback - estimate[6 + axis]
     return control
