@@ -18,6 +18,9 @@ ENV_IDS = {
 
 VECTOR_ENTRY_POINTS = {
     "etsc/AttitudeTracking-v0": "etsc_envs.attitude_tracking.env:AttitudeTrackingVectorEnv",
+    "etsc/OrbitAttitudeTracking-v0": (
+        "etsc_envs.orbit_attitude.env:OrbitAttitudeTrackingVectorEnv"
+    ),
     "etsc/InnerFormation-v0": "etsc_envs.inner_formation.env:InnerFormationVectorEnv",
     "etsc/AsteroidOrbitKeeping-v0": "etsc_envs.asteroid.env:AsteroidOrbitKeepingVectorEnv",
     "etsc/ClusterContainmentCentral-v0": (

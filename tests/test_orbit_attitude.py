@@ -219,12 +219,14 @@ def test_transmission_sends_the_command_and_restarts_the_integral():
     for _ in range(5):
         env.step(0)
     assert unwrapped.controller_state[14:16].min() > 0.0
-    fresh = unwrapped._channel_values().copy()
+    fresh = unwrapped.kernels.channel_values(
+        unwrapped.state, unwrapped.constants, unwrapped.time_s
+    )[0].copy()
     state = unwrapped.state_dict()
     assert_allclose(fresh, state["fresh_command"], rtol=1e-12)
     _, _, _, _, info = env.step(1)
     assert info["transmitted"] == 1
-    assert_array_equal(unwrapped.channel.held[0], fresh)
+    assert_array_equal(unwrapped.held[0], fresh)
     # after one period the integral holds h ϕ̂(t_k) only
     period = unwrapped.sampling_period_s
     assert_allclose(unwrapped.controller_state[14:16], period * state["phi_hat"], rtol=1e-12)

@@ -100,7 +100,7 @@ def run_scenario(scenario: Scenario, progress: bool = False) -> Run:
             signals[name][index] = state[name]
 
     sample(0)
-    times, commands = [0.0], [unwrapped.channel.held[0].copy()]
+    times, commands = [0.0], [unwrapped.held[0].copy()]
     total_return, steps = 0.0, 0
     started = time.perf_counter()
     bar = tqdm(total=unwrapped.n_steps, disable=not progress, desc=scenario.label, leave=False)
@@ -112,7 +112,7 @@ def run_scenario(scenario: Scenario, progress: bool = False) -> Run:
         total_return += reward
         if info["transmitted"]:
             times.append(time_before)
-            commands.append(unwrapped.channel.held[0].copy())
+            commands.append(unwrapped.held[0].copy())
         if steps % SAMPLE_EVERY == 0:
             sample(steps // SAMPLE_EVERY)
         if steps % 10_000 == 0:

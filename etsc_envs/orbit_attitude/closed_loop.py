@@ -9,12 +9,18 @@ adaptive law eq. (24) and the integral of eq. (23) — advance by one forward-Eu
 digital controller running at the sampling period does.
 
 Controller state ``c = [Ẑ1 (6), Ẑ2 (6), ϕ̂ (2), ∫_{t_k}^t ϕ̂ ds (2)]``.
+
+The environment keeps one loop in a flat state row (layout below) and reaches it through the
+kernels of :data:`KERNELS` (see :mod:`etsc_envs.core.compiled_loop`).
 """
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 
+from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
 from etsc_envs.core.rotations import se3_log
@@ -32,6 +38,7 @@ from etsc_envs.orbit_attitude.controller import (
     surface_drift,
 )
 from etsc_envs.orbit_attitude.dynamics import (
+    LeaderOrbit,
     PlantModel,
     error_pose,
     relative_derivative,
@@ -39,11 +46,52 @@ from etsc_envs.orbit_attitude.dynamics import (
 )
 
 N_FEATURES = 24
-N_CONTROLLER_STATE = 16
 N_DIAGNOSTICS = 14
 """``[‖Φ‖, ‖χ‖, max|Φ_i|, max|Δω_i|, max|χ_i|, max|Δv_i|, max|e1_i| (i ≤ 3), max|e1_i| (i > 3),
 max|(J e2)_i| (N·m), max|m e2_i| (N), Σ|u_a| h (N·s), ‖Δω‖, ‖Δv‖, 1 if all finite else 0]``
 after each step."""
+
+PLANT = slice(0, 13)  # y = [q_e, r_e, Δω, Δv] of the error variables (dynamics module)
+CONTROLLER = slice(13, 29)  # c = [Ẑ1, Ẑ2, ϕ̂, ∫_{t_k}^t ϕ̂ ds], eqs. (14), (23), (24)
+VIEW = slice(29, 41)  # [S, H1] the controller evaluated at the current instant
+COMMAND = slice(41, 47)  # Γ_cout a transmission now sends (eq. 22, integral of eq. 23 at zero)
+FEATURES = slice(47, 71)  # [e_c, S, η̃, Ṽ], see observation_features
+THRUSTER_OUTPUT = slice(71, 83)  # u_a over the last period, eqs. (10)-(12), N
+DIAGNOSTICS = slice(83, 97)  # the N_DIAGNOSTICS summary of the last step
+STEADY_MAX = slice(97, 105)  # maxima of DIAGNOSTICS[2:10] over the steady-state window
+IMPULSE = 105  # Σ|u_a| h over the episode, N·s
+SETTLING_BOUND = slice(106, 108)  # the settling bands on ‖Φ‖ and ‖χ‖
+SETTLING_TIME = slice(108, 110)  # since when ‖Φ‖ (‖χ‖) stays in its band; NaN while outside
+LEADER_RAAN = 110  # the leader's Ω, rad
+LEADER_LATITUDE = 111  # the leader's argument of latitude u(0), rad
+TORQUE_PHASE = slice(112, 115)  # phases of d_τ
+FORCE_PHASE = slice(115, 118)  # phases of d_f
+MISALIGNMENT = slice(118, 190)  # ΔD, 6×12 row-major
+STATE_WIDTH = 190
+"""Layout of the state row."""
+
+INTEGRAL = slice(14, 16)
+"""∫_{t_k}^t ϕ̂ ds inside the controller state ``c``."""
+
+NON_FINITE, POSITION_DIVERGED, RATE_DIVERGED, VELOCITY_DIVERGED = 1, 2, 3, 4
+"""Failure codes of :func:`loop_failure`."""
+
+LoopConstants = namedtuple(
+    "LoopConstants",
+    [
+        "model",  # PlantModel with the nominal leader angles, phases and D (ΔD = 0)
+        "gains",  # ControllerGains with the nominal leader angles
+        "cost_reference",  # the four references of tracking_cost
+        "plant_substeps",  # RK4 steps of the plant per sampling period
+        "steady_start",  # steps after which the steady-state window begins
+        "max_position_error",  # failure bounds on ‖χ‖ (m), ‖Δω‖ (rad/s), ‖Δv‖ (m/s)
+        "max_rate_error",
+        "max_velocity_error",
+    ],
+)
+"""What every episode shares; the leader's angles, the disturbance phases and ΔD of the
+episode are taken from the state row (:func:`episode_model`, :func:`episode_gains`)."""
+
 integrate_plant = make_rk4_step(relative_derivative)
 
 
@@ -134,12 +182,12 @@ def closed_loop_step(
 
     ``view = [S(t), H1(t)]`` is what the controller evaluated at t (returned by the previous
     step, or :func:`initial_view`). Returns ``(y_next, c_next, fresh_command, features,
-    view_next, cost, diagnostics, e1, e2, thruster_output)``: the states at t + h, the command a
+    view_next, cost, diagnostics, thruster_output)``: the states at t + h, the command a
     transmission at t + h would send, the observation features and ``[S, H1]`` there, the
-    step's :func:`tracking_cost` at t + h, the :data:`N_DIAGNOSTICS` summary, the ESO errors
-    ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at t + h (Δd with the command held over the period
-    just simulated; only if ``with_disturbance``, else zeros), and the thruster outputs u_a over
-    the period (N).
+    step's :func:`tracking_cost` at t + h, the :data:`N_DIAGNOSTICS` summary (its maxima of the
+    ESO errors ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at t + h, Δd with the command held over the
+    period just simulated, are computed only if ``with_disturbance``, else zero), and the
+    thruster outputs u_a over the period (N).
     """
     # controller at t: ESO, adaptive law and the integral of eq. (23), forward Euler
     surface = view[0:6]
@@ -188,7 +236,7 @@ def closed_loop_step(
     diagnostics[11] = np.sqrt(twist_error[0:3] @ twist_error[0:3])
     diagnostics[12] = np.sqrt(twist_error[3:6] @ twist_error[3:6])
     diagnostics[13] = 1.0 if np.isfinite(y_next).all() and np.isfinite(features).all() else 0.0
-    return y_next, c_next, fresh, features, view_next, cost, diagnostics, e1, e2, output
+    return y_next, c_next, fresh, features, view_next, cost, diagnostics, output
 
 
 @jit
@@ -199,3 +247,172 @@ def initial_view(y: np.ndarray, c: np.ndarray, gains: ControllerGains):
     view[0:6] = surface
     view[6:12] = drift
     return eta, view, command
+
+
+@jit
+def episode_leader(state: np.ndarray, shared: LeaderOrbit) -> LeaderOrbit:
+    """The leader's orbit of the episode: the shared one with the state row's Ω and u(0)."""
+    return LeaderOrbit(
+        shared.mu,
+        shared.radius,
+        shared.rate,
+        state[LEADER_RAAN],
+        shared.inclination,
+        state[LEADER_LATITUDE],
+    )
+
+
+@jit
+def episode_model(state: np.ndarray, constants: LoopConstants) -> PlantModel:
+    """The true plant of the episode: the shared model with the state row's leader, disturbance
+    phases and misalignment (D + ΔD)."""
+    shared = constants.model
+    return PlantModel(
+        episode_leader(state, shared.leader),
+        shared.earth_radius,
+        shared.j2,
+        shared.inertia,
+        shared.inertia_inv,
+        shared.mass,
+        shared.distribution + state[MISALIGNMENT].reshape(6, 12),
+        shared.allocation,
+        shared.max_force,
+        shared.bias_ratio,
+        shared.torque_offset,
+        shared.torque_amplitude,
+        shared.torque_frequency,
+        state[TORQUE_PHASE],
+        shared.force_offset,
+        shared.force_amplitude,
+        shared.force_frequency,
+        state[FORCE_PHASE],
+    )
+
+
+@jit
+def episode_gains(state: np.ndarray, constants: LoopConstants) -> ControllerGains:
+    """The controller of the episode: the shared gains with the state row's leader orbit."""
+    shared = constants.gains
+    return ControllerGains(
+        episode_leader(state, shared.leader),
+        shared.earth_radius,
+        shared.j2,
+        shared.inertia,
+        shared.inertia_inv,
+        shared.mass,
+        shared.theta1,
+        shared.theta2,
+        shared.alpha,
+        shared.singularity_floor,
+        shared.beta,
+        shared.alpha1,
+        shared.alpha2,
+        shared.k1,
+        shared.k2,
+        shared.k3,
+        shared.k4,
+        shared.k5,
+        shared.gain_k1,
+        shared.gain_k2,
+        shared.ell,
+        shared.epsilon,
+        shared.sigma,
+        shared.distribution,
+        shared.allocation,
+        shared.max_force,
+        shared.eso_sees_saturation,
+    )
+
+
+@jit
+def record_statistics(
+    state: np.ndarray, diagnostics: np.ndarray, time_next: float, steady: bool
+) -> None:
+    """Update the episode's running metrics with the step ending at ``time_next``: impulse,
+    settling times (‖Φ‖, ‖χ‖ re-entering their bands) and the steady-state maxima."""
+    state[IMPULSE] += diagnostics[10]
+    bounds = state[SETTLING_BOUND]
+    settled = state[SETTLING_TIME]
+    for i in range(2):
+        if diagnostics[i] > bounds[i]:
+            settled[i] = np.nan
+        elif np.isnan(settled[i]):
+            settled[i] = time_next
+    if steady:
+        state[STEADY_MAX] = np.maximum(state[STEADY_MAX], diagnostics[2:10])
+
+
+@jit
+def channel_values(state: np.ndarray, constants: LoopConstants, time_s: float) -> np.ndarray:
+    """The controller's transmission: the current Γ_cout with the integral restarted."""
+    return state[COMMAND].copy().reshape(1, 6)
+
+
+@jit
+def advance_loop(
+    state: np.ndarray,
+    constants: LoopConstants,
+    step_index: int,
+    h: float,
+    held: np.ndarray,
+    sent: np.ndarray,
+    channel_costs: np.ndarray,
+) -> None:
+    """One sampling period in the state row; the cost is :func:`tracking_cost` at t_k + h."""
+    if sent[0] != 0:  # a transmission at t_k restarts ∫_{t_k} ϕ̂ ds of eq. (23)
+        state[CONTROLLER][INTEGRAL] = 0.0
+    steady = step_index + 1 > constants.steady_start
+    (
+        state[PLANT],
+        state[CONTROLLER],
+        state[COMMAND],
+        state[FEATURES],
+        state[VIEW],
+        channel_costs[0],
+        state[DIAGNOSTICS],
+        state[THRUSTER_OUTPUT],
+    ) = closed_loop_step(
+        step_index * h,
+        h,
+        constants.plant_substeps,
+        state[PLANT],
+        state[CONTROLLER],
+        held[0],
+        episode_model(state, constants),
+        episode_gains(state, constants),
+        state[VIEW],
+        constants.cost_reference,
+        steady,
+    )
+    record_statistics(state, state[DIAGNOSTICS], (step_index + 1) * h, steady)
+
+
+@jit
+def loop_failure(state: np.ndarray, constants: LoopConstants) -> int:
+    """A non-finite state, or ‖χ‖, ‖Δω‖ or ‖Δv‖ beyond its bound (checked in that order)."""
+    diagnostics = state[DIAGNOSTICS]
+    if diagnostics[13] != 1.0:
+        return NON_FINITE
+    if diagnostics[1] > constants.max_position_error:
+        return POSITION_DIVERGED
+    if diagnostics[11] > constants.max_rate_error:
+        return RATE_DIVERGED
+    if diagnostics[12] > constants.max_velocity_error:
+        return VELOCITY_DIVERGED
+    return 0
+
+
+@jit
+def loop_features(state: np.ndarray, constants: LoopConstants, out: np.ndarray) -> None:
+    """The observation's features: ``[e_c, S, η̃, Ṽ]`` as computed by the last step."""
+    out[:] = state[FEATURES]
+
+
+KERNELS = ProblemKernels(
+    channel_values=channel_values,
+    accepts=always_accepts,
+    advance=advance_loop,
+    failure=loop_failure,
+    features=loop_features,
+)
+"""The compiled loop of paper 000."""

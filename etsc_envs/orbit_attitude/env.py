@@ -14,15 +14,39 @@ from typing import Any
 
 import numpy as np
 
-from etsc_envs.core.loop import EventTriggeredEnv
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector, se3_exp
 from etsc_envs.core.validation import apply_overrides
+from etsc_envs.core.vector_env import EventTriggeredVectorEnv
 from etsc_envs.orbit_attitude.closed_loop import (
-    N_CONTROLLER_STATE,
-    N_DIAGNOSTICS,
+    COMMAND,
+    CONTROLLER,
+    DIAGNOSTICS,
+    FEATURES,
+    FORCE_PHASE,
+    IMPULSE,
+    KERNELS,
+    LEADER_LATITUDE,
+    LEADER_RAAN,
+    MISALIGNMENT,
     N_FEATURES,
-    closed_loop_step,
+    NON_FINITE,
+    PLANT,
+    POSITION_DIVERGED,
+    RATE_DIVERGED,
+    SETTLING_BOUND,
+    SETTLING_TIME,
+    STATE_WIDTH,
+    STEADY_MAX,
+    THRUSTER_OUTPUT,
+    TORQUE_PHASE,
+    VELOCITY_DIVERGED,
+    VIEW,
+    LoopConstants,
     controller_view,
+    episode_gains,
+    episode_leader,
+    episode_model,
     initial_view,
     total_disturbance,
     tracking_cost,
@@ -174,6 +198,27 @@ def initial_state(phi_rad: np.ndarray, chi_m: np.ndarray, twist_error: np.ndarra
     return y
 
 
+def make_loop_constants(params: OrbitAttitudeParams) -> LoopConstants:
+    """What every episode of ``params`` shares: the model and gains with the scenario's leader
+    angles, disturbance phases and no misalignment (an episode's own are in its state row)."""
+    leader = make_leader(
+        params,
+        math.radians(params.leader_raan_deg),
+        math.radians(params.leader_latitude_argument_deg),
+    )
+    n_steps = round(params.horizon_s / params.sampling_period_s)
+    return LoopConstants(
+        model=make_plant_model(params, leader, np.zeros((6, 12))),
+        gains=make_controller_gains(params, leader),
+        cost_reference=COST_REFERENCE,
+        plant_substeps=int(params.plant_substeps),
+        steady_start=round((1.0 - STEADY_STATE_FRACTION) * n_steps),
+        max_position_error=float(params.max_position_error_m),
+        max_rate_error=float(params.max_rate_error_rad_s),
+        max_velocity_error=float(params.max_velocity_error_m_s),
+    )
+
+
 class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
     """Coupled orbit-attitude tracking with an event-triggered control channel (paper 000).
 
@@ -194,6 +239,8 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
     Action: ``Discrete(2)``, 1 transmits the current Γ_cout to the thrusters. Observation: the
     components named in :data:`FEATURE_NAMES` followed by ``time_since_transmission_s``.
     """
+
+    kernels = KERNELS
 
     def __init__(
         self,
@@ -225,36 +272,57 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             feature_high=high,
             n_channels=1,
             channel_width=6,
+            state_width=STATE_WIDTH,
+            constants=make_loop_constants(p),
             sampling_period_s=p.sampling_period_s,
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
             failure_cost=float(tracking_cost(failure_eta, failure_twist, COST_REFERENCE)),
         )
-        self._steady_start = round((1.0 - STEADY_STATE_FRACTION) * self.n_steps)
-        self.plant_state = np.zeros(13)
-        self.controller_state = np.zeros(N_CONTROLLER_STATE)
-        self._features_now = np.zeros(N_FEATURES)
-        self._fresh_command = np.zeros(6)
-        self._thruster_output = np.zeros(12)
-        self._eso_errors = np.zeros(12)
-        self._diagnostics = np.zeros(N_DIAGNOSTICS)
-        self._view = np.zeros(12)
-        self.misalignment = np.zeros((6, 12))
+
+    # ----------------------------------------------------------------- the episode's loop
+    @property
+    def plant_state(self) -> np.ndarray:
+        """``y = [q_e, r_e, Δω, Δv]`` at the current instant (a view of the state row)."""
+        return self.state[PLANT]
+
+    @property
+    def controller_state(self) -> np.ndarray:
+        """``c = [Ẑ1, Ẑ2, ϕ̂, ∫_{t_k}^t ϕ̂ ds]`` at the current instant (a view of the state row)."""
+        return self.state[CONTROLLER]
+
+    @property
+    def misalignment(self) -> np.ndarray:
+        """The episode's thruster misalignment ΔD, 6×12 (a view of the state row)."""
+        return self.state[MISALIGNMENT].reshape(6, 12)
+
+    @property
+    def leader(self) -> LeaderOrbit:
+        """The virtual leader's orbit of the current episode."""
+        return episode_leader(self.state, self.constants.gains.leader)
+
+    @property
+    def model(self) -> PlantModel:
+        """The true plant of the current episode (leader, disturbance phases, ΔD)."""
+        return episode_model(self.state, self.constants)
+
+    @property
+    def gains(self) -> ControllerGains:
+        """The controller of the current episode (its leader orbit)."""
+        return episode_gains(self.state, self.constants)
 
     # ----------------------------------------------------------------- hooks
     def _reset_problem(self, options: dict[str, Any] | None) -> None:
         p = self.params
         rng = self.np_random
+        state = self.state
         phi, chi = p.initial_error()
-        raan = math.radians(p.leader_raan_deg)
-        latitude = math.radians(p.leader_latitude_argument_deg)
-        torque_phase = force_phase = None
-        if p.misalignment_seed is None or self.randomize:
-            self.misalignment = p.misalignment_std * rng.normal(size=(6, 12))
-        else:
-            fixed = np.random.default_rng(p.misalignment_seed)
-            self.misalignment = p.misalignment_std * fixed.normal(size=(6, 12))
+        state[LEADER_RAAN] = math.radians(p.leader_raan_deg)
+        state[LEADER_LATITUDE] = math.radians(p.leader_latitude_argument_deg)
+        state[TORQUE_PHASE] = p.torque_disturbance_phase
+        state[FORCE_PHASE] = p.force_disturbance_phase
+        state[MISALIGNMENT] = self._draw_misalignment().ravel()
         if self.randomize:
             axis = rng.normal(size=3)
             axis /= np.linalg.norm(axis)
@@ -262,108 +330,51 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             direction = rng.normal(size=3)
             direction /= np.linalg.norm(direction)
             chi = rng.uniform(0.0, RANDOM_POSITION_MAX_M) * direction
-            raan, latitude = rng.uniform(0.0, 2.0 * np.pi, size=2)
-            torque_phase = rng.uniform(0.0, 2.0 * np.pi, size=3)
-            force_phase = rng.uniform(0.0, 2.0 * np.pi, size=3)
-        self.leader = make_leader(p, raan, latitude)
-        self.model = make_plant_model(p, self.leader, self.misalignment, torque_phase, force_phase)
-        self.gains = make_controller_gains(p, self.leader)
-        self.initial_eta = np.concatenate([phi, chi])
-        self.plant_state = initial_state(
-            phi, chi, np.asarray(p.initial_velocity_error, dtype=float)
-        )
-        c = np.zeros(N_CONTROLLER_STATE)
-        c[12:14] = p.adaptive_phi0
-        eta, self._view, command = initial_view(self.plant_state, c, self.gains)
-        surface = self._view[0:6]
+            state[LEADER_RAAN], state[LEADER_LATITUDE] = rng.uniform(0.0, 2.0 * np.pi, size=2)
+            state[TORQUE_PHASE] = rng.uniform(0.0, 2.0 * np.pi, size=3)
+            state[FORCE_PHASE] = rng.uniform(0.0, 2.0 * np.pi, size=3)
+        state[PLANT] = initial_state(phi, chi, np.asarray(p.initial_velocity_error, dtype=float))
+        controller = state[CONTROLLER]
+        controller[12:14] = p.adaptive_phi0
+        eta, state[VIEW], state[COMMAND] = initial_view(state[PLANT], controller, self.gains)
+        surface = state[VIEW][0:6]
         if p.observer_start == "first_measurement":
-            c[0:6] = surface
-        self.controller_state = c
-        self._fresh_command = command
-        self._features_now = np.zeros(N_FEATURES)
-        self._features_now[6:12] = surface
-        self._features_now[12:18] = eta
-        self._features_now[18:24] = self.plant_state[7:13]
-        self._thruster_output = thruster_outputs(command, self.model)[1]
-        self._eso_errors = np.zeros(12)
-        self._counted = 0
-        # running episode statistics: steady-state maxima, settling, impulse
-        self._steady_max = np.zeros(8)
-        self._impulse = 0.0
-        initial_norms = (float(np.linalg.norm(phi)), float(np.linalg.norm(chi)))
-        self._settling_bounds = tuple(SETTLING_BAND * n for n in initial_norms)
-        self._settle = [None if n > 0.0 else 0.0 for n in initial_norms]
+            controller[0:6] = surface
+        features = state[FEATURES]  # e_c = 0: the thrusters hold Γ_cout(0)
+        features[6:12] = surface
+        features[12:18] = eta
+        features[18:24] = state[PLANT][7:13]
+        state[THRUSTER_OUTPUT] = thruster_outputs(state[COMMAND], self.model)[1]
+        initial_norms = np.array([np.linalg.norm(phi), np.linalg.norm(chi)])
+        state[SETTLING_BOUND] = SETTLING_BAND * initial_norms
+        state[SETTLING_TIME] = np.where(initial_norms > 0.0, np.nan, 0.0)
 
-    def _channel_values(self) -> np.ndarray:
-        return self._fresh_command
+    def _draw_misalignment(self) -> np.ndarray:
+        """ΔD: the paper scenario's fixed draw, or one from the env's RNG when
+        ``misalignment_seed`` is ``None`` or ``randomize`` is set."""
+        p = self.params
+        if p.misalignment_seed is None or self.randomize:
+            rng = self.np_random
+        else:
+            rng = np.random.default_rng(p.misalignment_seed)
+        return p.misalignment_std * rng.normal(size=(6, 12))
 
-    def _advance(self) -> float:
-        transmissions = int(self.channel.transmissions[0])
-        if transmissions != self._counted:  # a transmission at t_k restarts ∫_{t_k} ϕ̂ ds
-            self._counted = transmissions
-            self.controller_state[14:16] = 0.0
-        steady = self.step_index + 1 > self._steady_start
-        (
-            self.plant_state,
-            self.controller_state,
-            self._fresh_command,
-            self._features_now,
-            self._view,
-            cost,
-            diagnostics,
-            self._eso_errors[0:6],
-            self._eso_errors[6:12],
-            self._thruster_output,
-        ) = closed_loop_step(
-            self.time_s,
-            self.sampling_period_s,
-            self.params.plant_substeps,
-            self.plant_state,
-            self.controller_state,
-            self.channel.held[0],
-            self.model,
-            self.gains,
-            self._view,
-            COST_REFERENCE,
-            steady,
-        )
-        self._diagnostics = diagnostics
-        self._impulse += diagnostics[10]
-        time_next = (self.step_index + 1) * self.sampling_period_s
-        for i in (0, 1):
-            if diagnostics[i] > self._settling_bounds[i]:
-                self._settle[i] = None
-            elif self._settle[i] is None:
-                self._settle[i] = time_next
-        if steady:
-            np.maximum(self._steady_max, diagnostics[2:10], out=self._steady_max)
-        return float(cost)
-
-    def _failure(self) -> str | None:
-        d = self._diagnostics
-        if d[13] != 1.0:
+    def _failure_message(self, code: int) -> str:
+        if code == NON_FINITE:
             return "non-finite state"
         p = self.params
-        if (
-            d[1] > p.max_position_error_m
-            or d[11] > p.max_rate_error_rad_s
-            or (d[12] > p.max_velocity_error_m_s)
-        ):
-            for name, value, bound, unit in (
-                ("chi", d[1], p.max_position_error_m, "m"),
-                ("dw", d[11], p.max_rate_error_rad_s, "rad/s"),
-                ("dv", d[12], p.max_velocity_error_m_s, "m/s"),
-            ):
-                if value > bound:
-                    return f"diverged: |{name}| = {value:.4g} {unit} > {bound:g} {unit}"
-        return None
-
-    def _features(self) -> np.ndarray:
-        return self._features_now
+        d = self.state[DIAGNOSTICS]
+        name, value, bound, unit = {
+            POSITION_DIVERGED: ("chi", d[1], p.max_position_error_m, "m"),
+            RATE_DIVERGED: ("dw", d[11], p.max_rate_error_rad_s, "rad/s"),
+            VELOCITY_DIVERGED: ("dv", d[12], p.max_velocity_error_m_s, "m/s"),
+        }[code]
+        return f"diverged: |{name}| = {value:.4g} {unit} > {bound:g} {unit}"
 
     def _paper_metrics(self) -> dict[str, Any]:
-        reached = self.step_index > self._steady_start
-        steady = self._steady_max if reached else np.full(8, np.nan)
+        state = self.state
+        reached = self.step_index > self.constants.steady_start
+        steady = state[STEADY_MAX] if reached else np.full(8, np.nan)
 
         def value(x: float, scale: float = 1.0) -> float | None:
             return None if not np.isfinite(x) else float(x) * scale
@@ -374,15 +385,15 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             "ss_angvel_err_degps": value(steady[1], deg),
             "ss_pos_err_m": value(steady[2]),
             "ss_vel_err_mps": value(steady[3]),
-            "settle_att_s": self._settle[0],
-            "settle_pos_s": self._settle[1],
+            "settle_att_s": value(state[SETTLING_TIME][0]),
+            "settle_pos_s": value(state[SETTLING_TIME][1]),
             "eso_ss_err": {
                 "e1_rot": value(steady[4]),
                 "e1_trans": value(steady[5]),
                 "e2_rot_Nm": value(steady[6]),
                 "e2_trans_N": value(steady[7]),
             },
-            "thruster_impulse_Ns": float(self._impulse),
+            "thruster_impulse_Ns": float(state[IMPULSE]),
         }
 
     # ----------------------------------------------------------------- diagnostics
@@ -394,17 +405,18 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         now (``held_command``).
         """
         t = self.time_s
+        y = self.plant_state
         c = self.controller_state
-        eta, surface, _, known, command, fresh = controller_view(t, self.plant_state, c, self.gains)
-        held = self.channel.held[0].copy()
-        wrench = thruster_outputs(held, self.model)[2]
-        disturbance = total_disturbance(
-            t, self.plant_state, wrench, held, known, self.model, self.gains
-        )
+        gains = self.gains
+        model = self.model
+        eta, surface, _, known, command, fresh = controller_view(t, y, c, gains)
+        held = self.held[0].copy()
+        wrench = thruster_outputs(held, model)[2]
+        disturbance = total_disturbance(t, y, wrench, held, known, model, gains)
         return {
             "time_s": np.array(t),
             "eta": eta,
-            "twist_error": self.plant_state[7:13].copy(),
+            "twist_error": y[7:13].copy(),
             "surface": surface,
             "z1_hat": c[0:6].copy(),
             "z2_hat": c[6:12].copy(),
@@ -412,9 +424,16 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             "e1": c[0:6] - surface,
             "e2": c[6:12] - disturbance,
             "phi_hat": c[12:14].copy(),
-            "k3": adaptive_gain(c[12:14], c[14:16], surface, t, self.gains),
+            "k3": adaptive_gain(c[12:14], c[14:16], surface, t, gains),
             "command": command,
             "fresh_command": fresh,
             "held_command": held,
-            "thruster_output": self._thruster_output.copy(),
+            "thruster_output": self.state[THRUSTER_OUTPUT].copy(),
         }
+
+
+class OrbitAttitudeTrackingVectorEnv(EventTriggeredVectorEnv):
+    """``num_envs`` :class:`OrbitAttitudeTrackingEnv` stepped in one compiled call (the id's
+    ``vector_entry_point``)."""
+
+    single_env_class = OrbitAttitudeTrackingEnv
