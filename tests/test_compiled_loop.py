@@ -16,13 +16,12 @@ from numpy.testing import assert_allclose, assert_array_equal
 from etsc_envs.core.compiled_loop import (
     ProblemKernels,
     allocate_loop_arrays,
-    interevent_summary,
     loop_rows,
     make_loop_step,
 )
 from etsc_envs.core.jit import jit
 from etsc_envs.core.loop_env import EventTriggeredEnv
-from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
+from etsc_envs.core.metrics import COMMON_EPISODE_KEYS, interevent_summary
 
 CONSTANTS = (np.array([1.0, 2.0]), 5.0)
 """(drift, bound). A plain tuple, not a namedtuple: the disk cache's index of the shared loop
@@ -249,6 +248,16 @@ def test_env_episode_ends_with_metrics_and_refuses_further_steps():
     assert metrics["final_x"] == env.state[0:2].tolist()
     with pytest.raises(RuntimeError, match="reset"):
         env.step(np.array([0, 0]))
+
+
+def test_env_metrics_of_an_empty_episode():
+    env = ToyEnv()
+    env.reset(seed=0)
+    metrics = env.episode_metrics()
+    assert metrics["steps"] == 0 and metrics["sim_time_s"] == 0.0
+    assert metrics["mean_cost"] == 0.0 and metrics["transmission_rate"] == 0.0
+    assert metrics["mean_interevent_s"] is None and metrics["min_interevent_s"] is None
+    assert metrics["failure"] is None
 
 
 def test_env_failure_is_reported_by_its_message():

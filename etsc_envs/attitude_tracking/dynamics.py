@@ -46,7 +46,10 @@ PlantModel = namedtuple(
 def inertia(t: float, model: PlantModel) -> np.ndarray:
     """True inertia J(t) = J0 + ΔJ(t) of section 4."""
     variation = model.inertia_amplitude * np.sin(model.inertia_frequency * t + model.inertia_phase)
-    return model.nominal_inertia + np.diag(variation)
+    inertia_now = model.nominal_inertia.copy()
+    for axis in range(3):
+        inertia_now[axis, axis] += variation[axis]
+    return inertia_now
 
 
 @jit

@@ -220,17 +220,6 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
     return loop_step
 
 
-def interevent_summary(
-    transmissions: np.ndarray, interevent_sum_s: np.ndarray, interevent_min_s: np.ndarray
-) -> tuple[float | None, float | None]:
-    """Mean and minimum time between consecutive transmissions of the given channels pooled
-    (``None`` when no channel transmitted twice)."""
-    intervals = int(np.maximum(np.asarray(transmissions) - 1, 0).sum())
-    if intervals == 0:
-        return None, None
-    return float(np.sum(interevent_sum_s) / intervals), float(np.min(interevent_min_s))
-
-
 def compiled_entry(dispatcher: Any, *args: Any) -> Callable[..., Any]:
     """The machine code of a compiled function for the types of ``args`` (compiled or loaded
     from the disk cache if need be).

@@ -31,9 +31,9 @@ from etsc_envs.core.compiled_loop import (
     ProblemKernels,
     allocate_loop_arrays,
     compiled_entry,
-    interevent_summary,
     make_loop_step,
 )
+from etsc_envs.core.metrics import communication_metrics
 from etsc_envs.core.validation import require_non_negative, require_positive
 
 
@@ -253,29 +253,9 @@ class EventTriggeredEnv(gym.Env):
         return info
 
     def episode_metrics(self) -> dict[str, Any]:
-        """The design page's common metrics and the paper's own, for the episode so far.
-
-        ``transmission_rate`` is transmissions per sampling instant and per channel, so that
-        1.0 means every channel sent at every instant whatever the number of channels.
-        """
-        arrays = self.arrays
-        steps = self.step_index
-        transmissions = arrays.transmissions[0]
-        mean_interevent_s, min_interevent_s = interevent_summary(
-            transmissions, arrays.interevent_sum_s[0], arrays.interevent_min_s[0]
-        )
-        record: dict[str, Any] = {
-            "steps": steps,
-            "sim_time_s": self.time_s,
-            "mean_cost": float(arrays.cost_sum[0]) / steps if steps else 0.0,
-            "transmissions": int(transmissions.sum()),
-            "transmission_rate": (
-                int(transmissions.sum()) / (steps * self.n_channels) if steps else 0.0
-            ),
-            "mean_interevent_s": mean_interevent_s,
-            "min_interevent_s": min_interevent_s,
-            "failure": self.failure,
-        }
+        """The design page's common metrics and the paper's own, for the episode so far."""
+        record = communication_metrics(self.arrays, self.time_s)
+        record["failure"] = self.failure
         record.update(self._paper_metrics())
         return record
 

@@ -29,8 +29,9 @@ import gymnasium as gym
 import numpy as np
 from pettingzoo import ParallelEnv
 
-from etsc_envs.core.compiled_loop import LoopArrays, interevent_summary
+from etsc_envs.core.compiled_loop import LoopArrays
 from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.metrics import interevent_summary
 
 CLOCK_NAME = "time_since_transmission_s"
 
