@@ -29,7 +29,7 @@ from etsc_envs.attitude_tracking.dynamics import (
 from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import dot
+from etsc_envs.core.linalg import fused_dot
 
 N_FEATURES = 13
 
@@ -106,8 +106,8 @@ def closed_loop_step(
     x_hat_next[0:3] = x_hat[0:3] + h * d_hat1
     x_hat_next[3:6] = x_hat[3:6] + h * d_hat2
     y_next = integrate_plant(t, y, h, (torque, model))
-    y_next[0:4] /= np.sqrt(dot(y_next[0:4], y_next[0:4]))
-    y_next[7:11] /= np.sqrt(dot(y_next[7:11], y_next[7:11]))
+    y_next[0:4] /= np.sqrt(fused_dot(y_next[0:4], y_next[0:4]))
+    y_next[7:11] /= np.sqrt(fused_dot(y_next[7:11], y_next[7:11]))
     t_next = t + h
     _, omega_e_next, z_next, _ = tracking_error(t_next, y_next, gains.attitude_gain, model)
     features = sensor_features(z_next, x_hat_next, xi, gains)
@@ -196,10 +196,10 @@ def loop_failure(state: np.ndarray, constants: LoopConstants) -> int:
     if not np.isfinite(state[PLANT].sum() + state[FEATURES].sum()):
         return NON_FINITE
     omega = state[4:7]
-    if np.sqrt(dot(omega, omega)) > constants.max_rate:
+    if np.sqrt(fused_dot(omega, omega)) > constants.max_rate:
         return OMEGA_DIVERGED
     omega_e = state[RATE_ERROR]
-    if np.sqrt(dot(omega_e, omega_e)) > constants.max_rate:
+    if np.sqrt(fused_dot(omega_e, omega_e)) > constants.max_rate:
         return RATE_ERROR_DIVERGED
     return 0
 

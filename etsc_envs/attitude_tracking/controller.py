@@ -11,7 +11,7 @@ from collections import namedtuple
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import matvec
+from etsc_envs.core.linalg import fused_matvec3
 from etsc_envs.core.rotations import solve3
 
 LoopGains = namedtuple(
@@ -49,7 +49,7 @@ def g2(y: np.ndarray, c: float) -> np.ndarray:
 @jit
 def control_law(x_hat1: np.ndarray, x_hat2: np.ndarray, gains: LoopGains) -> np.ndarray:
     """u = -J0 K̃ x̂_1 - J0 x̂_2 (eq. 24)."""
-    return -matvec(gains.nominal_inertia, gains.control_gain * x_hat1 + x_hat2)
+    return -fused_matvec3(gains.nominal_inertia, gains.control_gain * x_hat1 + x_hat2)
 
 
 @jit

@@ -12,7 +12,7 @@ from collections import namedtuple
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import matvec
+from etsc_envs.core.linalg import fused_matvec3
 from etsc_envs.core.rotations import (
     attitude_matrix,
     cross,
@@ -89,7 +89,8 @@ def rate_derivative(
     """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, with J = J(t)."""
     inertia_now = inertia(t, model)
     return solve3(
-        inertia_now, -cross(omega, matvec(inertia_now, omega)) + torque + disturbance(t, model)
+        inertia_now,
+        -cross(omega, fused_matvec3(inertia_now, omega)) + torque + disturbance(t, model),
     )
 
 
@@ -112,7 +113,7 @@ def tracking_error(t: float, y: np.ndarray, attitude_gain: np.ndarray, model: Pl
     """
     q_e = error_quaternion(y[0:4], y[7:11])
     dcm = attitude_matrix(q_e)
-    omega_e = y[4:7] - matvec(dcm, desired_rate(t, model))
+    omega_e = y[4:7] - fused_matvec3(dcm, desired_rate(t, model))
     z = omega_e + attitude_gain * q_e[0:3]
     return q_e, omega_e, z, dcm
 

@@ -19,6 +19,7 @@ All functions are compiled (see :mod:`etsc_envs.core.jit`) and take and return f
 import numpy as np
 
 from etsc_envs.core.jit import jit
+from etsc_envs.core.linalg import fused_dot, fused_matvec3
 
 _SMALL_ANGLE = 1e-8
 
@@ -64,7 +65,7 @@ def solve3(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     inv[0, 2] = a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]
     inv[1, 2] = a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]
     inv[2, 2] = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
-    return inv @ rhs / det
+    return fused_matvec3(inv, rhs) / det
 
 
 @jit
@@ -87,7 +88,7 @@ def quat_conjugate(q: np.ndarray) -> np.ndarray:
 @jit
 def quat_normalize(q: np.ndarray) -> np.ndarray:
     """Unit quaternion along ``q``."""
-    return q / np.sqrt(q @ q)
+    return q / np.sqrt(fused_dot(q, q))
 
 
 @jit
@@ -95,7 +96,7 @@ def quat_kinematics(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Quaternion rate ``q̇ = ½ q ⊗ [ω, 0]`` for the body-frame rate ω (eq. (1)/(2) of 002)."""
     out = np.empty(4)
     out[:3] = 0.5 * (q[3] * omega + cross(q[:3], omega))
-    out[3] = -0.5 * (q[:3] @ omega)
+    out[3] = -0.5 * fused_dot(q[:3], omega)
     return out
 
 
@@ -108,8 +109,20 @@ def error_quaternion(q: np.ndarray, q_desired: np.ndarray) -> np.ndarray:
 @jit
 def attitude_matrix(q: np.ndarray) -> np.ndarray:
     """DCM ``(1 - 2 q_vᵀq_v) I + 2 q_v q_vᵀ - 2 q4 q_v^×`` mapping R-frame to B-frame components."""
-    qv = q[:3]
-    return (1.0 - 2.0 * (qv @ qv)) * np.eye(3) + 2.0 * np.outer(qv, qv) - 2.0 * q[3] * skew(qv)
+    x, y, z = q[0], q[1], q[2]
+    diagonal = 1.0 - 2.0 * fused_dot(q[:3], q[:3])
+    twice_scalar = 2.0 * q[3]
+    out = np.empty((3, 3))
+    out[0, 0] = diagonal + 2.0 * (x * x)
+    out[1, 1] = diagonal + 2.0 * (y * y)
+    out[2, 2] = diagonal + 2.0 * (z * z)
+    out[0, 1] = 2.0 * (x * y) - twice_scalar * -z
+    out[0, 2] = 2.0 * (x * z) - twice_scalar * y
+    out[1, 0] = 2.0 * (y * x) - twice_scalar * z
+    out[1, 2] = 2.0 * (y * z) - twice_scalar * -x
+    out[2, 0] = 2.0 * (z * x) - twice_scalar * -y
+    out[2, 1] = 2.0 * (z * y) - twice_scalar * x
+    return out
 
 
 @jit

@@ -7,6 +7,7 @@ from collections import namedtuple
 import numpy as np
 
 from etsc_envs.core.jit import jit
+from etsc_envs.core.linalg import fused_multiply_add
 
 ObserverFeedback = namedtuple(
     "ObserverFeedback",
@@ -46,8 +47,10 @@ def control_law(estimate: np.ndarray, design: ObserverFeedback) -> np.ndarray:
     control = np.empty(3)
     for axis in range(3):
         row = design.feedback[axis]
-        feedback = (
-            row[0] * estimate[axis] + row[1] * estimate[3 + axis] + row[2] * estimate[6 + axis]
+        feedback = fused_multiply_add(
+            row[2],
+            estimate[6 + axis],
+            fused_multiply_add(row[1], estimate[3 + axis], row[0] * estimate[axis]),
         )
         control[axis] = -feedback - estimate[6 + axis]
     return control
