@@ -40,7 +40,7 @@ from etsc_envs.asteroid.dynamics import (
 )
 from etsc_envs.asteroid.gravity import Polyhedron
 from etsc_envs.asteroid.gravity_grid import collides, grid_clearance
-from etsc_envs.core.compiled_loop import ProblemKernels
+from etsc_envs.core.compiled_loop import ProblemKernels, stored_features
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
 from etsc_envs.core.rotations import error_quaternion
@@ -298,17 +298,11 @@ def loop_failure(state: np.ndarray, constants: LoopConstants) -> int:
     return int(state[FAILURE_CODE])
 
 
-@jit
-def loop_features(state: np.ndarray, constants: LoopConstants, out: np.ndarray) -> None:
-    """The observation's features, as computed by the last step (or the reset)."""
-    out[:] = state[FEATURES]
-
-
 KERNELS = ProblemKernels(
     channel_values=channel_values,
     accepts=accepts_burst,
     advance=advance_loop,
     failure=loop_failure,
-    features=loop_features,
+    features=stored_features(FEATURES),
 )
 """The compiled loop of paper 003."""

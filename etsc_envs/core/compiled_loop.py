@@ -84,6 +84,18 @@ def always_accepts(
     return True
 
 
+def stored_features(features: slice) -> Callable[..., None]:
+    """``features`` kernel of a problem whose step stores the observation's features in the
+    state row, at ``state[features]``."""
+    start, stop = features.start, features.stop
+
+    @jit
+    def copy_features(state: np.ndarray, constants, out: np.ndarray) -> None:
+        out[:] = state[start:stop]
+
+    return copy_features
+
+
 def allocate_loop_arrays(
     n_envs: int, n_channels: int, channel_width: int, n_features: int, state_width: int
 ) -> LoopArrays:

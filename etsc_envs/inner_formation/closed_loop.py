@@ -14,7 +14,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts
+from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts, stored_features
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
 from etsc_envs.inner_formation.controller import (
@@ -241,17 +241,11 @@ def loop_failure(state: np.ndarray, constants: LoopConstants) -> int:
     return 0
 
 
-@jit
-def loop_features(state: np.ndarray, constants: LoopConstants, out: np.ndarray) -> None:
-    """The observation's features: the sensor's, as computed by the last step."""
-    out[:] = state[FEATURES]
-
-
 KERNELS = ProblemKernels(
     channel_values=channel_values,
     accepts=always_accepts,
     advance=advance_loop,
     failure=loop_failure,
-    features=loop_features,
+    features=stored_features(FEATURES),
 )
 """The compiled loop of paper 004."""
