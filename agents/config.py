@@ -12,7 +12,18 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``n_envs: 1`` — environments stepped together (in the id's native vector env, one compiled
   call per step);
 * ``seed: 0`` — seeds the algorithm and the environments (``null`` leaves them unseeded);
-* ``out_dir`` — where the model, the resolved config and the summary are written.
+* ``out_dir`` — where the model, the resolved config and the summary are written;
+* ``normalize_observations: true`` — train on observations standardised by running
+  statistics (SB3's ``VecNormalize``), saved beside the model for evaluation;
+* ``normalize_rewards: false`` — also scale rewards by a running estimate of the return;
+* ``checkpoint_every: 0`` — save the model (and the statistics) every that many steps into
+  ``out_dir/checkpoints``, from which ``--resume`` continues; 0 saves no checkpoints;
+* ``evaluation_every: 0`` — every that many steps, run the current policy and the paper's
+  trigger on the paper scenario and log both (TensorBoard and ``out_dir/evaluations.json``);
+  0 never evaluates;
+* ``evaluation_env_kwargs: {}`` — env kwargs of that evaluation on top of the paper scenario
+  (``randomize`` is always false there), e.g. a shorter ``horizon_s``;
+* ``tensorboard: true`` — write TensorBoard logs into ``out_dir/tensorboard``.
 
 Every problem raises a ``ValueError`` naming the key and what it allows.
 """
@@ -21,6 +32,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import importlib.util
 import inspect
 from collections.abc import Mapping
 from pathlib import Path
@@ -45,6 +57,12 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "hyperparameters": {},
     "n_envs": 1,
     "seed": 0,
+    "normalize_observations": True,
+    "normalize_rewards": False,
+    "checkpoint_every": 0,
+    "evaluation_every": 0,
+    "evaluation_env_kwargs": {},
+    "tensorboard": True,
 }
 
 CONFIG_SET_ARGUMENTS = ("policy", "env", "seed")
@@ -64,6 +82,12 @@ class TrainConfig:
     n_envs: int
     seed: int | None
     out_dir: str
+    normalize_observations: bool
+    normalize_rewards: bool
+    checkpoint_every: int
+    evaluation_every: int
+    evaluation_env_kwargs: dict[str, Any]
+    tensorboard: bool
 
     @property
     def algorithm_class(self) -> type[BaseAlgorithm]:
@@ -89,9 +113,12 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     _check_key_set(raw)
     values = {**OPTIONAL_DEFAULTS, **raw}
     algorithm = _check_algorithm(values["algorithm"])
+    env_id = _check_env_id(values["env_id"])
+    env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
+    _check_algorithm_fits_env(algorithm, env_id, env_kwargs)
     return TrainConfig(
-        env_id=_check_env_id(values["env_id"]),
-        env_kwargs={**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])},
+        env_id=env_id,
+        env_kwargs=env_kwargs,
         algorithm=algorithm,
         policy=_check_policy(values["policy"], algorithm),
         hyperparameters=_check_hyperparameters(values["hyperparameters"], algorithm),
@@ -99,6 +126,16 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         n_envs=_check_positive_int("n_envs", values["n_envs"]),
         seed=_check_seed(values["seed"]),
         out_dir=_check_out_dir(values["out_dir"]),
+        normalize_observations=_check_bool(
+            "normalize_observations", values["normalize_observations"]
+        ),
+        normalize_rewards=_check_bool("normalize_rewards", values["normalize_rewards"]),
+        checkpoint_every=_check_non_negative_int("checkpoint_every", values["checkpoint_every"]),
+        evaluation_every=_check_non_negative_int("evaluation_every", values["evaluation_every"]),
+        evaluation_env_kwargs=_check_mapping(
+            "evaluation_env_kwargs", values["evaluation_env_kwargs"]
+        ),
+        tensorboard=_check_tensorboard(values["tensorboard"]),
     )
 
 
@@ -130,6 +167,20 @@ def _check_algorithm(name: Any) -> str:
     if name not in ALGORITHMS:
         raise ValueError(f"config key 'algorithm': {name!r} is not one of {list(ALGORITHMS)}")
     return name
+
+
+def _check_algorithm_fits_env(algorithm: str, env_id: str, env_kwargs: dict[str, Any]) -> None:
+    """DQN picks one of finitely many actions: it needs a ``Discrete`` action space."""
+    if algorithm != "DQN":
+        return
+    env = gym.make(env_id, **env_kwargs)
+    action_space = env.action_space
+    env.close()
+    if not isinstance(action_space, gym.spaces.Discrete):
+        raise ValueError(
+            f"config key 'algorithm': DQN needs a Discrete action space, and {env_id} acts "
+            f"with {action_space}; use PPO or A2C"
+        )
 
 
 def _check_policy(policy: Any, algorithm: str) -> str:
@@ -209,3 +260,25 @@ def _check_out_dir(value: Any) -> str:
     if not isinstance(value, str | Path) or not str(value):
         raise ValueError(f"config key 'out_dir' must be a directory path, got {value!r}")
     return str(value)
+
+
+def _check_bool(key: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise ValueError(f"config key {key!r} must be true or false, got {value!r}")
+    return value
+
+
+def _check_non_negative_int(key: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"config key {key!r} must be an integer >= 0, got {value!r}")
+    return value
+
+
+def _check_tensorboard(value: Any) -> bool:
+    enabled = _check_bool("tensorboard", value)
+    if enabled and importlib.util.find_spec("tensorboard") is None:
+        raise ValueError(
+            "config key 'tensorboard': the tensorboard package is not installed "
+            "(pip install -e '.[train]'), or set tensorboard: false"
+        )
+    return enabled

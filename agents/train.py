@@ -1,11 +1,16 @@
 """Train a trigger policy with Stable-Baselines3 from a YAML config.
 
-``python -m agents.train --config configs/train/NAME.yaml [--timesteps N] [--seed S] [--out DIR]``
+``python -m agents.train --config configs/train/NAME.yaml [--timesteps N] [--seed S] [--out DIR]
+[--resume]``
 
 Writes to the output directory ``model.zip`` (a plain SB3 save, loadable by
-``python -m baselines.evaluate ENV_ID --policy sb3:DIR/model.zip``), ``config.yaml`` (the config
-after the command-line overrides and defaults) and ``train_summary.json`` (wall time, timesteps,
-steps per second and the last episodes' returns and metrics).
+``python -m baselines.evaluate ENV_ID --policy sb3:DIR/model.zip``) with
+``model_vecnormalize.pkl`` beside it when observations are normalised, ``config.yaml`` (the
+config after the command-line overrides and defaults), ``train_summary.json`` (wall time,
+timesteps, steps per second and the last episodes' returns and metrics), and as configured
+``checkpoints/``, ``tensorboard/`` and ``evaluations.json`` (the policy against the paper's
+trigger during training). ``--resume`` continues from the newest checkpoint in
+``checkpoints/`` up to ``total_timesteps``.
 """
 
 from __future__ import annotations
@@ -23,16 +28,22 @@ import gymnasium as gym
 import numpy as np
 import yaml
 from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
 from stable_baselines3.common.env_util import make_vec_env
-from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor
+from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 
 from agents.config import TrainConfig, load_config
+from agents.evaluation import PaperComparisonCallback
 from agents.vector_adapter import make_sb3_vec_env
+from baselines.policies import normalization_path
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
 SUMMARY_FILE = "train_summary.json"
+EVALUATIONS_FILE = "evaluations.json"
+CHECKPOINT_DIR = "checkpoints"
+CHECKPOINT_PREFIX = "model"
+TENSORBOARD_DIR = "tensorboard"
 RECENT_EPISODES_KEPT = 5
 """How many of the last finished episodes ``train_summary.json`` reports."""
 
@@ -66,43 +77,116 @@ def _plain(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def train(config: TrainConfig) -> Path:
-    """Train the configured model, write the three output files and return the output folder."""
+def train(config: TrainConfig, resume: bool = False) -> Path:
+    """Train the configured model (from the newest checkpoint if ``resume``), write the output
+    files and return the output folder."""
     out_dir = Path(config.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    env = make_training_env(config)
-    model = config.algorithm_class(config.policy, env, seed=config.seed, **config.hyperparameters)
+    checkpoint = latest_checkpoint(out_dir / CHECKPOINT_DIR) if resume else None
+    if resume and checkpoint is None:
+        raise ValueError(f"--resume: no checkpoint in {out_dir / CHECKPOINT_DIR}")
+    env = make_training_env(config, checkpoint)
+    tensorboard_log = str(out_dir / TENSORBOARD_DIR) if config.tensorboard else None
+    if checkpoint is None:
+        model = config.algorithm_class(
+            config.policy,
+            env,
+            seed=config.seed,
+            tensorboard_log=tensorboard_log,
+            **config.hyperparameters,
+        )
+    else:
+        model = config.algorithm_class.load(
+            checkpoint, env=env, device="cpu", tensorboard_log=tensorboard_log
+        )
     metrics_callback = EpisodeMetricsCallback()
     start = time.perf_counter()
     model.learn(
-        total_timesteps=config.total_timesteps,
-        callback=metrics_callback,
+        total_timesteps=max(config.total_timesteps - model.num_timesteps, 0),
+        callback=CallbackList([metrics_callback, *_periodic_callbacks(config, out_dir)]),
         progress_bar=_progress_bar_available(),
+        reset_num_timesteps=checkpoint is None,
     )
     wall_time_s = time.perf_counter() - start
-    env.close()
     model.save(out_dir / MODEL_FILE)
+    normalization = model.get_vec_normalize_env()
+    if normalization is not None:
+        normalization.save(normalization_path(out_dir / MODEL_FILE))
+    env.close()
     _write_config(config, out_dir / CONFIG_FILE)
     summary = _summary(config, model, metrics_callback, wall_time_s)
+    summary["resumed_from"] = None if checkpoint is None else str(checkpoint)
     (out_dir / SUMMARY_FILE).write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     return out_dir
 
 
-def make_training_env(config: TrainConfig) -> VecEnv:
-    """``config.n_envs`` environments of ``config.env_id`` as one SB3 ``VecEnv`` with episode
-    statistics: the id's native vector env through :class:`SB3VecEnvAdapter` when it has one
-    (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs."""
-    if gym.spec(config.env_id).vector_entry_point is not None:
-        env = make_sb3_vec_env(config.env_id, config.n_envs, **config.env_kwargs)
-        env.seed(config.seed)
-        return VecMonitor(env)
-    return make_vec_env(
-        functools.partial(gym.make, config.env_id),
-        n_envs=config.n_envs,
-        seed=config.seed,
-        env_kwargs=config.env_kwargs,
-        vec_env_cls=DummyVecEnv,
+def latest_checkpoint(folder: Path) -> Path | None:
+    """The checkpoint with the most timesteps in ``folder`` (``model_<N>_steps.zip``)."""
+    checkpoints = sorted(
+        folder.glob(f"{CHECKPOINT_PREFIX}_*_steps.zip"),
+        key=lambda path: int(path.stem.split("_")[-2]),
     )
+    return checkpoints[-1] if checkpoints else None
+
+
+def _periodic_callbacks(config: TrainConfig, out_dir: Path) -> list[BaseCallback]:
+    """Checkpoints and evaluations against the paper trigger, as configured."""
+    callbacks: list[BaseCallback] = []
+    if config.checkpoint_every:
+        callbacks.append(
+            CheckpointCallback(
+                save_freq=max(config.checkpoint_every // config.n_envs, 1),
+                save_path=str(out_dir / CHECKPOINT_DIR),
+                name_prefix=CHECKPOINT_PREFIX,
+                save_vecnormalize=config.normalize_observations or config.normalize_rewards,
+            )
+        )
+    if config.evaluation_every:
+        callbacks.append(
+            PaperComparisonCallback(
+                config.env_id,
+                {**config.env_kwargs, **config.evaluation_env_kwargs},
+                config.evaluation_every,
+                out_dir / EVALUATIONS_FILE,
+            )
+        )
+    return callbacks
+
+
+def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> VecEnv:
+    """``config.n_envs`` environments of ``config.env_id`` as one SB3 ``VecEnv`` with episode
+    statistics and, as configured, normalisation (restored from ``checkpoint``'s statistics
+    when resuming): the id's native vector env through :class:`SB3VecEnvAdapter` when it has
+    one (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs."""
+    if gym.spec(config.env_id).vector_entry_point is not None:
+        env: VecEnv = VecMonitor(
+            make_sb3_vec_env(config.env_id, config.n_envs, **config.env_kwargs)
+        )
+        env.seed(config.seed)
+    else:
+        env = make_vec_env(
+            functools.partial(gym.make, config.env_id),
+            n_envs=config.n_envs,
+            seed=config.seed,
+            env_kwargs=config.env_kwargs,
+            vec_env_cls=DummyVecEnv,
+        )
+    if not (config.normalize_observations or config.normalize_rewards):
+        return env
+    if checkpoint is not None:
+        return VecNormalize.load(str(_checkpoint_statistics(checkpoint)), env)
+    return VecNormalize(
+        env,
+        norm_obs=config.normalize_observations,
+        norm_reward=config.normalize_rewards,
+        gamma=config.hyperparameters.get("gamma", 0.99),
+    )
+
+
+def _checkpoint_statistics(checkpoint: Path) -> Path:
+    """The statistics SB3's ``CheckpointCallback`` saved with ``model_<N>_steps.zip``."""
+    steps = checkpoint.stem.split("_")[-2]
+    return checkpoint.with_name(f"{CHECKPOINT_PREFIX}_vecnormalize_{steps}_steps.pkl")
 
 
 def _progress_bar_available() -> bool:
@@ -141,6 +225,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--timesteps", type=int, help="override total_timesteps")
     parser.add_argument("--seed", type=int, help="override seed")
     parser.add_argument("--out", type=Path, help="override out_dir")
+    parser.add_argument(
+        "--resume", action="store_true", help="continue from the newest checkpoint of out_dir"
+    )
     return parser
 
 
@@ -159,9 +246,12 @@ def main(argv: list[str] | None = None) -> int:
         )
     except (OSError, ValueError, yaml.YAMLError) as error:
         parser.error(str(error))
-    out_dir = train(config)
-    for name in (MODEL_FILE, CONFIG_FILE, SUMMARY_FILE):
-        print(f"wrote {out_dir / name}")
+    try:
+        out_dir = train(config, resume=args.resume)
+    except ValueError as error:
+        parser.error(str(error))
+    for path in sorted(out_dir.iterdir()):
+        print(f"wrote {path}")
     return 0
 
 

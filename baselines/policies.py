@@ -8,6 +8,7 @@ runs paper triggers, periodic schedules and trained models alike.
 from __future__ import annotations
 
 import json
+import pickle
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -122,8 +123,54 @@ def infer_sb3_algorithm(path: str | Path) -> type:
     return algorithm
 
 
+NORMALIZATION_SUFFIX = "_vecnormalize.pkl"
+"""A model ``NAME.zip`` trained on normalised observations keeps the statistics beside it, in
+``NAME_vecnormalize.pkl`` (Stable-Baselines3's pickled ``VecNormalize``)."""
+
+
+def normalization_path(model_path: str | Path) -> Path:
+    """Where the observation statistics of the model saved at ``model_path`` live."""
+    model_path = Path(model_path)
+    return model_path.with_name(model_path.stem + NORMALIZATION_SUFFIX)
+
+
+class NormalizedModel:
+    """A Stable-Baselines3 model that reads observations through saved ``VecNormalize``
+    statistics (frozen: evaluation does not update them).
+
+    Args:
+        model: the loaded model.
+        normalization: the unpickled ``VecNormalize`` (its ``venv`` may be unset).
+    """
+
+    def __init__(self, model: Any, normalization: Any) -> None:
+        self.model = model
+        self.normalization = normalization
+        self.normalization.training = False
+        self.observation_space = model.observation_space
+        self.action_space = model.action_space
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        normalized = self.normalization.normalize_obs(np.asarray(observation, dtype=np.float32))
+        return self.model.predict(
+            normalized, state=state, episode_start=episode_start, deterministic=deterministic
+        )
+
+
 def load_sb3(path: str | Path, env: gym.Env | None = None) -> Any:
-    """Load a saved Stable-Baselines3 model, whichever algorithm trained it."""
+    """Load a saved Stable-Baselines3 model, whichever algorithm trained it, with the
+    observation statistics saved beside it if there are any (see :func:`normalization_path`)."""
     if not Path(path).is_file():
         raise ValueError(f"sb3 model file not found: {path}")
-    return infer_sb3_algorithm(path).load(path, env=env, device="cpu")
+    model = infer_sb3_algorithm(path).load(path, env=env, device="cpu")
+    statistics = normalization_path(path)
+    if not statistics.is_file():
+        return model
+    with open(statistics, "rb") as stream:
+        return NormalizedModel(model, pickle.load(stream))

@@ -15,21 +15,45 @@ stable_baselines3 = pytest.importorskip("stable_baselines3")
 from agents.config import config_from_dict  # noqa: E402
 from agents.train import CONFIG_FILE, MODEL_FILE, SUMMARY_FILE, main  # noqa: E402
 
-SHIPPED_CONFIG = Path(__file__).parents[1] / "configs" / "train" / "attitude_tracking_ppo.yaml"
+CONFIG_DIR = Path(__file__).parents[1] / "configs" / "train"
+SHIPPED_CONFIG = CONFIG_DIR / "attitude_tracking_ppo.yaml"
+
+SHORT_EPISODES = {
+    "etsc/AttitudeTracking-v0": {"horizon_s": 0.05},
+    "etsc/InnerFormation-v0": {"horizon_s": 0.05},
+    "etsc/OrbitAttitudeTracking-v0": {"horizon_s": 0.05},
+    "etsc/ClusterContainmentCentral-v0": {"horizon_s": 0.5},
+    "etsc/AsteroidOrbitKeeping-v0": {"horizon_s": 60.0},
+}
+"""Env kwargs that make each id's training and evaluation episodes a few dozen steps long."""
 
 
-def shipped_config() -> dict[str, Any]:
-    """The shipped PPO config as a mapping."""
-    return yaml.safe_load(SHIPPED_CONFIG.read_text(encoding="utf-8"))
+def shipped_config(path: Path = SHIPPED_CONFIG) -> dict[str, Any]:
+    """A shipped config as a mapping."""
+    return yaml.safe_load(path.read_text(encoding="utf-8"))
 
 
-def tiny_config(out_dir: Path) -> dict[str, Any]:
-    """The shipped config shrunk to a run of a few seconds."""
-    config = shipped_config()
-    config["env_kwargs"]["horizon_s"] = 0.2
+def tiny_config(out_dir: Path, path: Path = SHIPPED_CONFIG) -> dict[str, Any]:
+    """A shipped config shrunk to a run of a few seconds."""
+    config = shipped_config(path)
+    short = SHORT_EPISODES[config["env_id"]]
+    config["env_kwargs"].update(short)
     config["hyperparameters"].update(n_steps=64, batch_size=64)
-    config.update(total_timesteps=256, n_envs=1, out_dir=str(out_dir))
+    config.update(
+        total_timesteps=256,
+        n_envs=1,
+        out_dir=str(out_dir),
+        checkpoint_every=0,
+        evaluation_every=0,
+        evaluation_env_kwargs=dict(short),
+    )
     return config
+
+
+def write_config(config: dict[str, Any], folder: Path) -> Path:
+    path = folder / "tiny.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    return path
 
 
 def test_train_writes_a_loadable_model(tmp_path: Path) -> None:
@@ -45,7 +69,7 @@ def test_train_writes_a_loadable_model(tmp_path: Path) -> None:
     assert resolved["seed"] == 3
     summary = json.loads((out_dir / SUMMARY_FILE).read_text(encoding="utf-8"))
     assert summary["timesteps"] >= 256
-    assert summary["recent_episodes"], "0.2-s episodes of 200 steps must finish within 256 steps"
+    assert summary["recent_episodes"], "50-step episodes must finish within 256 steps"
     assert "E_v" in summary["recent_episodes"][-1]
 
     model = stable_baselines3.PPO.load(out_dir / MODEL_FILE, device="cpu")
@@ -71,4 +95,85 @@ def test_config_rejects_an_unknown_hyperparameter(tmp_path: Path) -> None:
     config = tiny_config(tmp_path)
     config["hyperparameters"]["n_step"] = 64
     with pytest.raises(ValueError, match="n_step"):
+        config_from_dict(config)
+
+
+@pytest.mark.parametrize("config_path", sorted(CONFIG_DIR.glob("*.yaml")), ids=lambda p: p.stem)
+def test_every_shipped_config_trains_saves_reloads_and_evaluates(
+    config_path: Path, tmp_path: Path
+) -> None:
+    from baselines.evaluate import main as evaluate_main
+    from baselines.policies import NormalizedModel, load_sb3, normalization_path
+
+    out_dir = tmp_path / "run"
+    config = tiny_config(out_dir, config_path) | {"n_envs": 2, "evaluation_every": 128}
+    assert main(["--config", str(write_config(config, tmp_path))]) == 0
+
+    model_path = out_dir / MODEL_FILE
+    assert normalization_path(model_path).is_file(), "observation statistics beside the model"
+    assert any((out_dir / "tensorboard").rglob("events.out.tfevents.*"))
+    evaluations = json.loads((out_dir / "evaluations.json").read_text(encoding="utf-8"))
+    assert evaluations and {"learned", "paper", "timesteps"} <= set(evaluations[0])
+    assert evaluations[0]["paper"]["transmissions"] >= 0
+    assert isinstance(load_sb3(model_path), NormalizedModel)
+
+    record_path = tmp_path / "evaluation.json"
+    env_args = [
+        f"--env-arg={key}={value}" for key, value in SHORT_EPISODES[config["env_id"]].items()
+    ]
+    assert (
+        evaluate_main(
+            [
+                config["env_id"],
+                "--policy",
+                f"sb3:{model_path}",
+                *env_args,
+                "--json",
+                str(record_path),
+            ]
+        )
+        == 0
+    )
+    record = json.loads(record_path.read_text(encoding="utf-8"))
+    assert record["episodes"][0]["steps"] > 0
+
+
+def test_resume_continues_from_the_newest_checkpoint(tmp_path: Path) -> None:
+    out_dir = tmp_path / "run"
+    config = tiny_config(out_dir) | {"checkpoint_every": 64, "total_timesteps": 128}
+    config_path = write_config(config, tmp_path)
+    assert main(["--config", str(config_path)]) == 0
+    checkpoints = sorted((out_dir / "checkpoints").glob("model_*_steps.zip"))
+    assert checkpoints, "checkpoints were written"
+    assert main(["--config", str(config_path), "--timesteps", "320", "--resume"]) == 0
+    summary = json.loads((out_dir / SUMMARY_FILE).read_text(encoding="utf-8"))
+    assert summary["resumed_from"].endswith("model_128_steps.zip")
+    assert summary["timesteps"] >= 320
+    assert summary["timesteps"] < 320 + 128, "resuming does not start the count again"
+
+
+def test_resume_without_checkpoints_is_a_clear_error(tmp_path: Path) -> None:
+    config_path = write_config(tiny_config(tmp_path / "run"), tmp_path)
+    with pytest.raises(SystemExit):
+        main(["--config", str(config_path), "--resume"])
+
+
+def test_config_rejects_dqn_for_a_multibinary_action(tmp_path: Path) -> None:
+    config = tiny_config(tmp_path, CONFIG_DIR / "inner_formation_ppo.yaml")
+    config.update(algorithm="DQN", hyperparameters={})
+    with pytest.raises(ValueError, match="DQN needs a Discrete action space"):
+        config_from_dict(config)
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("checkpoint_every", -1, "'checkpoint_every' must be an integer >= 0"),
+        ("normalize_observations", "yes", "'normalize_observations' must be true or false"),
+        ("evaluation_env_kwargs", [1], "'evaluation_env_kwargs' must be a mapping"),
+    ],
+)
+def test_config_rejects_bad_training_options(tmp_path: Path, key, value, message) -> None:
+    config = tiny_config(tmp_path) | {key: value}
+    with pytest.raises(ValueError, match=message):
         config_from_dict(config)
