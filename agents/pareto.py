@@ -1,0 +1,168 @@
+"""Accuracy against transmissions: the paper's trigger, periodic sampling and learned triggers.
+
+    python -m agents.pareto ENV_ID [--model PATH ...] [--env-arg k=v ...] [--seed S]
+                                   [--out DIR]
+
+Runs one episode of the paper scenario (``randomize`` off) for every point of three curves and
+plots ``mean_cost`` (the per-step accuracy cost the reward penalises) against the number of
+transmissions:
+
+* the paper's trigger over a sweep of its threshold (:data:`PAPER_SWEEPS`: Ψ for 002, γ1 and
+  γ2 for 000, c for 001, α for 003, Π for 004), the paper's own value included;
+* periodic transmission every ``k`` sampling instants (:data:`PERIODIC_EVERY`);
+* each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
+  typically one per transmission penalty λ.
+
+Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
+``results/pareto/<env name>``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+import etsc_envs  # noqa: F401  (registers the ids)
+from agents.evaluation import episode_summary
+from baselines.cli import make_policy, parse_assignments
+from baselines.episodes import run_episode
+from baselines.triggers.asteroid import PAPER_ALPHA
+from baselines.triggers.attitude_tracking import PAPER_PSI
+from baselines.triggers.inner_formation import default_thresholds
+from baselines.triggers.orbit_attitude import PAPER_GAMMA
+
+SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
+"""Multiples of the paper's threshold swept where the threshold is a free positive number."""
+
+
+def _scaled(**paper_values: float) -> list[dict[str, float]]:
+    return [{name: scale * value for name, value in paper_values.items()} for scale in SCALES]
+
+
+def _inner_formation_sweep() -> list[dict[str, float]]:
+    pi1, pi2, pi3 = default_thresholds()
+    return _scaled(pi1=pi1, pi2=pi2, pi3=pi3)
+
+
+PAPER_SWEEPS = {
+    "etsc/AttitudeTracking-v0": lambda: _scaled(psi=PAPER_PSI),
+    "etsc/OrbitAttitudeTracking-v0": lambda: [
+        {"gamma1": scale * PAPER_GAMMA[0], "gamma2": scale * PAPER_GAMMA[1]}
+        for scale in (0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
+    ],
+    "etsc/ClusterContainmentCentral-v0": lambda: [{"c": c} for c in (0.2, 0.4, 0.6, 0.8, 0.95)],
+    "etsc/AsteroidOrbitKeeping-v0": lambda: _scaled(alpha=PAPER_ALPHA),
+    "etsc/InnerFormation-v0": _inner_formation_sweep,
+}
+"""Id → the paper-trigger arguments of each point (the paper's own values among them)."""
+
+PERIODIC_EVERY = (1, 2, 5, 10, 20, 50, 100, 200)
+"""Sampling instants between periodic transmissions."""
+
+
+def run_point(
+    env: gym.Env, policy_spec: str, policy_args: dict[str, Any], env_id: str, seed: int
+) -> dict[str, Any]:
+    """One paper-scenario episode of a policy: its compared metrics and what it was."""
+    policy = make_policy(policy_spec, env, policy_args, env_id)
+    record, _ = run_episode(env, policy, seed=seed)
+    return {"policy": policy_spec, "args": policy_args, **episode_summary(record)}
+
+
+def pareto(
+    env_id: str,
+    models: list[str],
+    env_kwargs: dict[str, Any],
+    seed: int = 0,
+) -> dict[str, Any]:
+    """The three curves of the module docstring for ``env_id``."""
+    if env_id not in PAPER_SWEEPS:
+        raise ValueError(f"no Pareto sweep for {env_id}; known: {sorted(PAPER_SWEEPS)}")
+    env = gym.make(env_id, **{**env_kwargs, "randomize": False})
+    curves = {
+        "paper": [run_point(env, "paper", args, env_id, seed) for args in PAPER_SWEEPS[env_id]()],
+        "periodic": [
+            run_point(env, "periodic", {"every": every}, env_id, seed) for every in PERIODIC_EVERY
+        ],
+        "learned": [run_point(env, f"sb3:{path}", {}, env_id, seed) for path in models],
+    }
+    env.close()
+    return {"env": env_id, "env_kwargs": env_kwargs, "seed": seed, "curves": curves}
+
+
+def plot(result: dict[str, Any], path: Path) -> None:
+    """``mean_cost`` against transmissions, one marker style per curve (log-log axes)."""
+    figure, axes = plt.subplots(figsize=(6.0, 4.5))
+    styles = {"paper": "o-", "periodic": "s--", "learned": "*"}
+    labels = {
+        "paper": "paper trigger (threshold sweep)",
+        "periodic": "periodic",
+        "learned": "learned",
+    }
+    for name, points in result["curves"].items():
+        finished = [p for p in points if p["failure"] is None and p["transmissions"] > 0]
+        if not finished:
+            continue
+        finished.sort(key=lambda point: point["transmissions"])
+        axes.plot(
+            [point["transmissions"] for point in finished],
+            [point["mean_cost"] for point in finished],
+            styles[name],
+            label=labels[name],
+            markersize=10 if name == "learned" else 5,
+        )
+    axes.set_xscale("log")
+    axes.set_yscale("log")
+    axes.set_xlabel("transmissions per episode")
+    axes.set_ylabel("mean_cost (accuracy cost per step)")
+    axes.set_title(f"{result['env']}: accuracy against communication", fontsize=10)
+    axes.legend()
+    axes.grid(True, which="both", alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m agents.pareto",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("env_id", choices=sorted(PAPER_SWEEPS))
+    parser.add_argument(
+        "--model", action="append", default=[], help="an SB3 zip of a learned trigger (repeatable)"
+    )
+    parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
+    parser.add_argument("--seed", type=int, default=0, help="reset seed of every episode")
+    parser.add_argument("--out", type=Path, help="output folder")
+    args = parser.parse_args(argv)
+    try:
+        env_kwargs = parse_assignments(args.env_arg, "--env-arg")
+        result = pareto(args.env_id, args.model, env_kwargs, args.seed)
+    except ValueError as error:
+        parser.error(str(error))
+    out_dir = args.out or Path("results") / "pareto" / args.env_id.split("/")[-1]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "pareto.json").write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    plot(result, out_dir / "pareto.png")
+    for name, points in result["curves"].items():
+        for point in points:
+            print(
+                f"{name:9s} {json.dumps(point['args']):48s} mean_cost {point['mean_cost']:.4g}  "
+                f"transmissions {point['transmissions']}"
+            )
+    print(f"wrote {out_dir / 'pareto.json'} and {out_dir / 'pareto.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

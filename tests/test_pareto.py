@@ -1,0 +1,43 @@
+"""``python -m agents.pareto``: the three curves, their JSON and their plot."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+from agents.pareto import PAPER_SWEEPS, PERIODIC_EVERY, main
+from baselines.triggers.attitude_tracking import PAPER_PSI
+
+
+def test_pareto_writes_the_paper_and_periodic_curves(tmp_path: Path) -> None:
+    out_dir = tmp_path / "pareto"
+    argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.3", "--out", str(out_dir)]
+    assert main(argv) == 0
+    result = json.loads((out_dir / "pareto.json").read_text(encoding="utf-8"))
+    assert (out_dir / "pareto.png").stat().st_size > 0
+    curves = result["curves"]
+    assert len(curves["paper"]) == len(PAPER_SWEEPS["etsc/AttitudeTracking-v0"]())
+    assert any(point["args"] == {"psi": PAPER_PSI} for point in curves["paper"])
+    assert [point["args"]["every"] for point in curves["periodic"]] == list(PERIODIC_EVERY)
+    assert curves["learned"] == []
+    steps = 300
+    for point in curves["periodic"]:
+        assert point["transmissions"] == -(-steps // point["args"]["every"])  # at k = 0, K, 2K..
+    paper_counts = [point["transmissions"] for point in curves["paper"]]
+    assert paper_counts == sorted(paper_counts, reverse=True), "a higher Ψ transmits less"
+
+
+@pytest.mark.parametrize("env_id", sorted(PAPER_SWEEPS))
+def test_every_sweep_is_accepted_by_its_paper_trigger(env_id: str) -> None:
+    import gymnasium as gym
+
+    from baselines.cli import make_policy
+
+    env = gym.make(env_id)
+    for args in PAPER_SWEEPS[env_id]():
+        make_policy("paper", env, args, env_id)
+    env.close()
