@@ -4,11 +4,21 @@ Checked on seeded random matrices of the shapes the suite uses (3×3, 3×6, 6×3
 non-contiguous views (slices of larger arrays), which the compiled code passes around.
 """
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
+from numba import njit
 from numpy.testing import assert_allclose
 
-from etsc_envs.core.linalg import matmul, matvec, matvec_transposed
+from etsc_envs.core.linalg import (
+    fused_dot,
+    fused_matvec3,
+    fused_multiply_add,
+    matmul,
+    matvec,
+    matvec_transposed,
+)
 
 SHAPES = [(3, 3), (3, 6), (6, 3), (1, 4)]
 
@@ -37,3 +47,44 @@ def test_products_accept_non_contiguous_views():
     assert not matrix.flags.c_contiguous
     assert_allclose(matvec(matrix, vector), matrix @ vector, rtol=1e-14, atol=1e-14)
     assert_allclose(matmul(matrix, matrix.T), matrix @ matrix.T, rtol=1e-14, atol=1e-14)
+
+
+@njit
+def _compiled_blas_dot(left, right):
+    return left @ right
+
+
+@njit
+def _compiled_blas_matvec(matrix, vector):
+    return matrix @ vector
+
+
+@njit
+def _compiled_fused_multiply_add(left, right, addend):
+    return fused_multiply_add(left, right, addend)
+
+
+def test_fused_products_return_the_bits_of_compiled_blas():
+    """The fused helpers replace ``@`` inside compiled code without changing a bit (the papers'
+    reproductions rely on it). Should this fail on another machine, its BLAS kernels round
+    differently, and the reproductions' last digits may differ there too."""
+    rng = np.random.default_rng(11)
+    for _ in range(2000):
+        scale = 10.0 ** rng.uniform(-8, 6, size=3)
+        matrix, vector = rng.normal(size=(3, 3)) * scale, rng.normal(size=3)
+        quaternion = rng.normal(size=4)
+        assert fused_dot(vector * scale, vector) == _compiled_blas_dot(vector * scale, vector)
+        assert fused_dot(quaternion, quaternion) == _compiled_blas_dot(quaternion, quaternion)
+        assert np.array_equal(fused_matvec3(matrix, vector), _compiled_blas_matvec(matrix, vector))
+
+
+def test_fused_multiply_add_rounds_once_compiled_and_in_python():
+    rng = np.random.default_rng(12)
+    for _ in range(500):
+        left, right, addend = rng.normal(size=3) * 10.0 ** rng.uniform(-5, 5, size=3)
+        exact = float(Fraction(left) * Fraction(right) + Fraction(addend))
+        assert fused_multiply_add(left, right, addend) == exact
+        assert _compiled_fused_multiply_add(left, right, addend) == exact
+    # a case where rounding the product first loses the answer entirely
+    left = 1.0 + 2.0**-30
+    assert _compiled_fused_multiply_add(left, left, -(1.0 + 2.0**-29)) == 2.0**-60

@@ -240,4 +240,6 @@ def compiled_entry(dispatcher: Any, *args: Any) -> Callable[..., Any]:
     namedtuples of arrays, against about 2 µs for the call itself. Later calls must pass
     arguments of exactly the same types (the same arrays' dtypes, dimensions and layouts).
     """
+    if not hasattr(dispatcher, "compile"):  # NUMBA_DISABLE_JIT=1: a plain Python function
+        return dispatcher
     return dispatcher.compile(tuple(dispatcher.typeof_pyval(arg) for arg in args))

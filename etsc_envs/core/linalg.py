@@ -5,9 +5,11 @@ overhead (~150 ns) dwarfs the arithmetic; these loops do the same products in a 
 nanoseconds. Any shapes are accepted, so they also serve 3×6 regressors.
 """
 
+from fractions import Fraction
+
 import numpy as np
 from numba import types
-from numba.extending import intrinsic
+from numba.extending import intrinsic, overload
 
 from etsc_envs.core.jit import jit
 
@@ -50,15 +52,31 @@ def matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return out
 
 
+def fused_multiply_add(left: float, right: float, addend: float) -> float:
+    """``left * right + addend`` rounded once, as a fused multiply-add does.
+
+    Compiled, this is LLVM's ``llvm.fma.f64`` (exact on every CPU); as plain Python (with
+    ``NUMBA_DISABLE_JIT=1``) the exact rational result rounded to the nearest float.
+    """
+    return float(Fraction(left) * Fraction(right) + Fraction(addend))
+
+
 @intrinsic
-def fused_multiply_add(typingctx, left, right, addend):
-    """``left * right + addend`` rounded once (LLVM's ``llvm.fma.f64``, exact on every CPU)."""
+def _llvm_fma(typingctx, left, right, addend):
     signature = types.float64(types.float64, types.float64, types.float64)
 
     def codegen(context, builder, sig, args):
         return builder.fma(*args)
 
     return signature, codegen
+
+
+@overload(fused_multiply_add, jit_options={"cache": True})
+def _fused_multiply_add_compiled(left, right, addend):
+    def implementation(left, right, addend):
+        return _llvm_fma(left, right, addend)
+
+    return implementation
 
 
 @jit
