@@ -25,15 +25,13 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.evaluation import episode_summary
 from baselines.cli import make_policy, parse_assignments
 from baselines.episodes import run_episode
+from baselines.plotting import save
 from baselines.triggers.asteroid import PAPER_ALPHA
 from baselines.triggers.attitude_tracking import PAPER_PSI
 from baselines.triggers.inner_formation import default_thresholds
@@ -126,9 +124,7 @@ def plot(result: dict[str, Any], path: Path) -> None:
     axes.set_title(f"{result['env']}: accuracy against communication", fontsize=10)
     axes.legend()
     axes.grid(True, which="both", alpha=0.3)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    save(figure, path)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -72,9 +72,9 @@ integrate_loop = make_rk4_step(loop_derivative)
 
 
 @jit
-def estimation_errors(t: float, y: np.ndarray, model: RelativeMotionModel, design):
-    """|r - ζ|, |ṙ - ψ|, |h - φ| per axis (the left sides of eqs. 8-10), and ḣ."""
-    control = control_law(y[6:15], design)
+def estimation_errors(t: float, y: np.ndarray, control: np.ndarray, model: RelativeMotionModel):
+    """|r - ζ|, |ṙ - ψ|, |h - φ| per axis (the left sides of eqs. 8-10), and ḣ, given the
+    feedback ``control`` of eq. (16) at ``y``."""
     lumped = lumped_term(t, y[0:3], y[3:6], model)
     rate = lumped_term_rate(t, y[0:3], y[3:6], lumped + control, model)
     return (
@@ -111,10 +111,10 @@ def closed_loop_step(
     """
     y_next = integrate_loop(t, y, h, (held_position, model, design))
     t_next = t + h
-    position_error, velocity_error, disturbance_error, lumped_rate = estimation_errors(
-        t_next, y_next, model, design
-    )
     control = control_law(y_next[6:15], design)
+    position_error, velocity_error, disturbance_error, lumped_rate = estimation_errors(
+        t_next, y_next, control, model
+    )
     features = sensor_features(y_next, held_position)
     return (
         y_next,
