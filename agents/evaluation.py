@@ -7,11 +7,10 @@ import pickle
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
 from stable_baselines3.common.callbacks import BaseCallback
 
-from baselines.cli import make_policy
-from baselines.episodes import run_episode, to_jsonable
+from baselines.cli import EpisodeSetup, episode_setup
+from baselines.episodes import to_jsonable
 from baselines.policies import NormalizedModel
 
 COMPARED_KEYS = ("mean_cost", "transmissions", "transmission_rate", "failure")
@@ -49,12 +48,11 @@ class PaperComparisonCallback(BaseCallback):
         self.evaluations: list[dict[str, Any]] = []
         self.paper: dict[str, Any] = {}
         self._next_evaluation = every
-        self._env: gym.Env | None = None
+        self._setup: EpisodeSetup | None = None
 
     def _on_training_start(self) -> None:
-        self._env = gym.make(self.env_id, **self.env_kwargs)
-        paper_trigger = make_policy("paper", self._env, {}, self.env_id)
-        record, _ = run_episode(self._env, paper_trigger, seed=0)
+        self._setup = episode_setup(self.env_id, self.env_kwargs)
+        record, _ = self._setup.run(self._setup.env, self._setup.make_policy("paper", {}), seed=0)
         self.paper = episode_summary(record)
         self._next_evaluation = self.num_timesteps + self.every
 
@@ -62,7 +60,7 @@ class PaperComparisonCallback(BaseCallback):
         if self.num_timesteps < self._next_evaluation:
             return True
         self._next_evaluation += self.every
-        record, _ = run_episode(self._env, self._current_policy(), seed=0)
+        record, _ = self._setup.run(self._setup.env, self._current_policy(), seed=0)
         learned = episode_summary(record)
         self.evaluations.append(
             {"timesteps": self.num_timesteps, "learned": learned, "paper": self.paper}
@@ -74,8 +72,8 @@ class PaperComparisonCallback(BaseCallback):
         return True
 
     def _on_training_end(self) -> None:
-        if self._env is not None:
-            self._env.close()
+        if self._setup is not None:
+            self._setup.env.close()
 
     def _current_policy(self) -> Any:
         """The model, reading observations through a frozen copy of the training statistics."""

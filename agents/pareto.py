@@ -9,7 +9,7 @@ transmissions:
 
 * the paper's trigger over a sweep of its threshold (:data:`PAPER_SWEEPS`: Ψ for 002, γ1 and
   γ2 for 000, c for 001, α for 003, Π for 004), the paper's own value included;
-* periodic transmission every ``k`` sampling instants (:data:`PERIODIC_EVERY`);
+* periodic transmission every ``k`` sampling instants (:func:`periodic_sweep`);
 * each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
   typically one per transmission penalty λ.
 
@@ -24,13 +24,11 @@ import json
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
 import matplotlib.pyplot as plt
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.evaluation import episode_summary
-from baselines.cli import make_policy, parse_assignments
-from baselines.episodes import run_episode
+from baselines.cli import EpisodeSetup, episode_setup, parse_assignments
 from baselines.plotting import save
 from baselines.triggers.asteroid import PAPER_ALPHA
 from baselines.triggers.attitude_tracking import PAPER_PSI
@@ -50,13 +48,18 @@ def _inner_formation_sweep() -> list[dict[str, float]]:
     return _scaled(pi1=pi1, pi2=pi2, pi3=pi3)
 
 
+def _cluster_sweep() -> list[dict[str, float]]:
+    return [{"c": c} for c in (0.2, 0.4, 0.6, 0.8, 0.95)]
+
+
 PAPER_SWEEPS = {
     "etsc/AttitudeTracking-v0": lambda: _scaled(psi=PAPER_PSI),
     "etsc/OrbitAttitudeTracking-v0": lambda: [
         {"gamma1": scale * PAPER_GAMMA[0], "gamma2": scale * PAPER_GAMMA[1]}
         for scale in (0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
     ],
-    "etsc/ClusterContainmentCentral-v0": lambda: [{"c": c} for c in (0.2, 0.4, 0.6, 0.8, 0.95)],
+    "etsc/ClusterContainmentCentral-v0": _cluster_sweep,
+    "etsc/ClusterContainment-v0": _cluster_sweep,
     "etsc/AsteroidOrbitKeeping-v0": lambda: _scaled(alpha=PAPER_ALPHA),
     "etsc/InnerFormation-v0": _inner_formation_sweep,
 }
@@ -65,13 +68,28 @@ PAPER_SWEEPS = {
 PERIODIC_EVERY = (1, 2, 5, 10, 20, 50, 100, 200)
 """Sampling instants between periodic transmissions."""
 
+PERIODIC_EVERY_BY_ID = {
+    # A burst fires for 50 s = 200 sampling instants, so requests closer than that all land
+    # inside a running burst: periodic bursts start 200 instants apart at the closest.
+    "etsc/AsteroidOrbitKeeping-v0": (200, 240, 300, 400, 600, 800, 1200, 1600),
+    # The paper's trigger updates a follower every few seconds (hundreds of 0.01-s instants).
+    "etsc/ClusterContainmentCentral-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000),
+    "etsc/ClusterContainment-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000),
+}
+"""Ids whose periodic sweep differs from :data:`PERIODIC_EVERY`."""
+
+
+def periodic_sweep(env_id: str) -> tuple[int, ...]:
+    """Sampling instants between periodic transmissions swept for ``env_id``."""
+    return PERIODIC_EVERY_BY_ID.get(env_id, PERIODIC_EVERY)
+
 
 def run_point(
-    env: gym.Env, policy_spec: str, policy_args: dict[str, Any], env_id: str, seed: int
+    setup: EpisodeSetup, policy_spec: str, policy_args: dict[str, Any], seed: int
 ) -> dict[str, Any]:
     """One paper-scenario episode of a policy: its compared metrics and what it was."""
-    policy = make_policy(policy_spec, env, policy_args, env_id)
-    record, _ = run_episode(env, policy, seed=seed)
+    policy = setup.make_policy(policy_spec, policy_args)
+    record, _ = setup.run(setup.env, policy, seed=seed)
     return {"policy": policy_spec, "args": policy_args, **episode_summary(record)}
 
 
@@ -84,15 +102,15 @@ def pareto(
     """The three curves of the module docstring for ``env_id``."""
     if env_id not in PAPER_SWEEPS:
         raise ValueError(f"no Pareto sweep for {env_id}; known: {sorted(PAPER_SWEEPS)}")
-    env = gym.make(env_id, **{**env_kwargs, "randomize": False})
+    setup = episode_setup(env_id, {**env_kwargs, "randomize": False})
     curves = {
-        "paper": [run_point(env, "paper", args, env_id, seed) for args in PAPER_SWEEPS[env_id]()],
+        "paper": [run_point(setup, "paper", args, seed) for args in PAPER_SWEEPS[env_id]()],
         "periodic": [
-            run_point(env, "periodic", {"every": every}, env_id, seed) for every in PERIODIC_EVERY
+            run_point(setup, "periodic", {"every": every}, seed) for every in periodic_sweep(env_id)
         ],
-        "learned": [run_point(env, f"sb3:{path}", {}, env_id, seed) for path in models],
+        "learned": [run_point(setup, f"sb3:{path}", {}, seed) for path in models],
     }
-    env.close()
+    setup.env.close()
     return {"env": env_id, "env_kwargs": env_kwargs, "seed": seed, "curves": curves}
 
 

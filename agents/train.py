@@ -26,15 +26,17 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+import torch
 import yaml
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 
+import etsc_envs
 from agents.config import TrainConfig, load_config
 from agents.evaluation import PaperComparisonCallback
-from agents.vector_adapter import make_sb3_vec_env
+from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
 from baselines.policies import normalization_path
 
 MODEL_FILE = "model.zip"
@@ -80,6 +82,7 @@ def _plain(value: Any) -> Any:
 def train(config: TrainConfig, resume: bool = False) -> Path:
     """Train the configured model (from the newest checkpoint if ``resume``), write the output
     files and return the output folder."""
+    torch.set_num_threads(config.torch_threads)
     out_dir = Path(config.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     checkpoint = latest_checkpoint(out_dir / CHECKPOINT_DIR) if resume else None
@@ -157,11 +160,16 @@ def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> Ve
     """``config.n_envs`` environments of ``config.env_id`` as one SB3 ``VecEnv`` with episode
     statistics and, as configured, normalisation (restored from ``checkpoint``'s statistics
     when resuming): the id's native vector env through :class:`SB3VecEnvAdapter` when it has
-    one (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs."""
-    if gym.spec(config.env_id).vector_entry_point is not None:
+    one (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs; for a PettingZoo id,
+    every agent of the shared loops' vector env
+    (:class:`~agents.vector_adapter.SharedPolicyVecEnv`)."""
+    if config.env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env: VecEnv = VecMonitor(
-            make_sb3_vec_env(config.env_id, config.n_envs, **config.env_kwargs)
+            make_shared_policy_vec_env(config.env_id, config.n_envs, **config.env_kwargs)
         )
+        env.seed(config.seed)
+    elif gym.spec(config.env_id).vector_entry_point is not None:
+        env = VecMonitor(make_sb3_vec_env(config.env_id, config.n_envs, **config.env_kwargs))
         env.seed(config.seed)
     else:
         env = make_vec_env(

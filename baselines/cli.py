@@ -6,12 +6,13 @@ import json
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import gymnasium as gym
 import yaml
 
-from baselines.episodes import to_jsonable
+import etsc_envs
+from baselines.episodes import run_episode, run_parallel_episode, to_jsonable
 from baselines.policies import AlwaysPolicy, PeriodicPolicy, load_sb3
 from baselines.triggers import PAPER_TRIGGERS
 
@@ -73,6 +74,31 @@ def make_agent_policy(spec: str, env: Any, policy_args: dict[str, Any], env_id: 
         policy_args,
         env_id,
     )
+
+
+class EpisodeSetup(NamedTuple):
+    """An environment ready for evaluation episodes, with how to make policies for it and how
+    to run one episode (Gymnasium and PettingZoo ids alike)."""
+
+    env: Any
+    make_policy: Callable[[str, dict[str, Any]], Any]
+    """``(spec, policy_args) -> policy`` (for a PettingZoo id, one policy serves all agents)."""
+    run: Callable[..., tuple[dict[str, Any], Any]]
+    """:func:`~baselines.episodes.run_episode` or its PettingZoo form."""
+
+
+def episode_setup(env_id: str, env_args: dict[str, Any]) -> EpisodeSetup:
+    """``env_id`` (a Gymnasium or a PettingZoo id) built with ``env_args``, as an
+    :class:`EpisodeSetup`."""
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env = etsc_envs.make_parallel(env_id, **env_args)
+        return EpisodeSetup(
+            env,
+            lambda spec, args: make_agent_policy(spec, env, args, env_id),
+            run_parallel_episode,
+        )
+    env = gym.make(env_id, **env_args)
+    return EpisodeSetup(env, lambda spec, args: make_policy(spec, env, args, env_id), run_episode)
 
 
 def _policy_for(

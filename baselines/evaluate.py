@@ -16,15 +16,8 @@ from typing import Any
 
 import gymnasium as gym
 
-import etsc_envs
-from baselines.cli import (
-    POLICY_CHOICES,
-    make_agent_policy,
-    make_policy,
-    parse_assignments,
-    write_json,
-)
-from baselines.episodes import mean_record, run_episode, run_parallel_episode
+from baselines.cli import POLICY_CHOICES, episode_setup, parse_assignments, write_json
+from baselines.episodes import mean_record
 from baselines.plotting import plot_episode
 
 
@@ -48,14 +41,8 @@ def evaluate(
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     policy_args, env_args = dict(policy_args or {}), dict(env_args or {})
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        env = etsc_envs.make_parallel(env_id, **env_args)
-        trigger = make_agent_policy(policy, env, policy_args, env_id)
-        runner = run_parallel_episode
-    else:
-        env = gym.make(env_id, **env_args)
-        trigger = make_policy(policy, env, policy_args, env_id)
-        runner = run_episode
+    env, make_trigger, runner = episode_setup(env_id, env_args)
+    trigger = make_trigger(policy, policy_args)
     records = []
     for episode in range(episodes):
         record, trace = runner(

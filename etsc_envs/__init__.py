@@ -44,6 +44,12 @@ PETTINGZOO_ENV_IDS = {
 """PettingZoo id → module with ``parallel_env``, ``env`` and ``raw_env`` (PettingZoo has no
 global registry; use :func:`make_parallel` or :func:`make_aec`)."""
 
+PETTINGZOO_LOOP_IDS = {
+    "etsc/ClusterContainment-v0": "etsc/ClusterContainmentCentral-v0",
+}
+"""PettingZoo id → the Gymnasium id of the closed loop its agents share (the central form, one
+transmit bit per agent), whose native vector env trains one policy for all agents."""
+
 
 def _pettingzoo_module(env_id: str):
     import importlib

@@ -7,6 +7,9 @@ some |x_c| exceeds a bound; channel 1's receiver refuses transmissions while x_1
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from typing import Any
 
 import numpy as np
@@ -284,3 +287,30 @@ def test_env_bad_action_names_what_is_allowed(action):
 def test_env_bad_arguments_name_the_argument(kwargs, message):
     with pytest.raises(ValueError, match=message):
         ToyEnv(**kwargs)
+
+
+def test_a_new_process_loads_the_loop_step_from_the_disk_cache(tmp_path):
+    """The loop step closes over the problem's compiled kernels; its disk-cache entry must
+    match in the next process (Numba's own key for closures never does, see
+    ``ClosureFunctionCache``), or every process pays the 8–11-s compile again."""
+    if os.environ.get("NUMBA_DISABLE_JIT") == "1":
+        pytest.skip("nothing is compiled under NUMBA_DISABLE_JIT=1")
+    script = (
+        "import gymnasium as gym, etsc_envs\n"
+        "env = gym.make('etsc/InnerFormation-v0')\n"
+        "env.reset(seed=0)\n"
+        "env.step(env.action_space.sample())\n"
+        "print(sum(env.unwrapped.loop_step.stats.cache_hits.values()))\n"
+    )
+    environment = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    hits = [
+        subprocess.run(
+            [sys.executable, "-c", script],
+            env=environment,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.split()[-1]
+        for _ in range(2)
+    ]
+    assert hits == ["0", "1"], "compiled in the first process, loaded in the second"

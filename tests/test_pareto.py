@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.pareto import PAPER_SWEEPS, PERIODIC_EVERY, main
+from agents.pareto import PAPER_SWEEPS, main, periodic_sweep
 from baselines.triggers.attitude_tracking import PAPER_PSI
 
 
@@ -22,7 +22,8 @@ def test_pareto_writes_the_paper_and_periodic_curves(tmp_path: Path) -> None:
     curves = result["curves"]
     assert len(curves["paper"]) == len(PAPER_SWEEPS["etsc/AttitudeTracking-v0"]())
     assert any(point["args"] == {"psi": PAPER_PSI} for point in curves["paper"])
-    assert [point["args"]["every"] for point in curves["periodic"]] == list(PERIODIC_EVERY)
+    periods = [point["args"]["every"] for point in curves["periodic"]]
+    assert periods == list(periodic_sweep("etsc/AttitudeTracking-v0"))
     assert curves["learned"] == []
     steps = 300
     for point in curves["periodic"]:
@@ -33,11 +34,9 @@ def test_pareto_writes_the_paper_and_periodic_curves(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("env_id", sorted(PAPER_SWEEPS))
 def test_every_sweep_is_accepted_by_its_paper_trigger(env_id: str) -> None:
-    import gymnasium as gym
+    from baselines.cli import episode_setup
 
-    from baselines.cli import make_policy
-
-    env = gym.make(env_id)
+    setup = episode_setup(env_id, {})
     for args in PAPER_SWEEPS[env_id]():
-        make_policy("paper", env, args, env_id)
-    env.close()
+        setup.make_policy("paper", args)
+    setup.env.close()

@@ -23,6 +23,7 @@ SHORT_EPISODES = {
     "etsc/InnerFormation-v0": {"horizon_s": 0.05},
     "etsc/OrbitAttitudeTracking-v0": {"horizon_s": 0.05},
     "etsc/ClusterContainmentCentral-v0": {"horizon_s": 0.5},
+    "etsc/ClusterContainment-v0": {"horizon_s": 0.5},
     "etsc/AsteroidOrbitKeeping-v0": {"horizon_s": 60.0},
 }
 """Env kwargs that make each id's training and evaluation episodes a few dozen steps long."""

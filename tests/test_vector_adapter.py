@@ -9,7 +9,13 @@ from numpy.testing import assert_array_equal
 from stable_baselines3 import PPO
 from stable_baselines3.common.vec_env import VecMonitor
 
-from agents.vector_adapter import SB3VecEnvAdapter, make_sb3_vec_env, unbatch_info
+import etsc_envs
+from agents.vector_adapter import (
+    SB3VecEnvAdapter,
+    make_sb3_vec_env,
+    make_shared_policy_vec_env,
+    unbatch_info,
+)
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 SHORT = {"horizon_s": 0.01, "randomize": True}
@@ -74,3 +80,53 @@ def test_ppo_trains_through_the_adapter_on_a_native_vector_env():
     assert model.num_timesteps >= 256
     assert len(model.ep_info_buffer) > 0, "VecMonitor saw finished episodes through the adapter"
     env.close()
+
+
+CLUSTER_ID = "etsc/ClusterContainment-v0"
+CLUSTER_SHORT = {"horizon_s": 0.05, "randomize": True}
+
+
+def test_shared_policy_env_presents_each_agent_as_its_parallel_env_does():
+    rows = 2
+    shared = make_shared_policy_vec_env(CLUSTER_ID, rows, **CLUSTER_SHORT)
+    shared.seed(3)
+    observations = shared.reset()
+    parallel = [etsc_envs.make_parallel(CLUSTER_ID, **CLUSTER_SHORT) for _ in range(rows)]
+    agents = parallel[0].possible_agents
+    n_agents = len(agents)
+    assert shared.num_envs == rows * n_agents
+    assert shared.observation_space == parallel[0].observation_space(agents[0])
+    references = [env.reset(seed=3 + row)[0] for row, env in enumerate(parallel)]
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        for row in range(rows):
+            for agent_index, agent in enumerate(agents):
+                assert_array_equal(
+                    observations[row * n_agents + agent_index], references[row][agent]
+                )
+        bits = rng.integers(0, 2, size=shared.num_envs)
+        observations, rewards, dones, infos = shared.step(bits)
+        for row, env in enumerate(parallel):
+            actions = {agent: int(bits[row * n_agents + i]) for i, agent in enumerate(agents)}
+            references[row], agent_rewards, *_ = env.step(actions)
+            expected = [agent_rewards[agent] for agent in agents]
+            assert_array_equal(rewards[row * n_agents : (row + 1) * n_agents], np.float32(expected))
+    assert dones.all(), "a 5-step horizon ends every row at the 5th step, all agents together"
+    assert "episode_metrics" in infos[0] and "episode_metrics" not in infos[1]
+    for row in range(rows):
+        for agent_index, agent in enumerate(agents):
+            info = infos[row * n_agents + agent_index]
+            assert info["TimeLimit.truncated"] is True
+            assert_array_equal(info["terminal_observation"], references[row][agent])
+
+
+def test_shared_policy_env_needs_a_pettingzoo_id():
+    with pytest.raises(ValueError, match="not a PettingZoo id"):
+        make_shared_policy_vec_env(ENV_ID, 2)
+
+
+def test_ppo_trains_one_policy_for_every_agent():
+    shared = VecMonitor(make_shared_policy_vec_env(CLUSTER_ID, 2, **CLUSTER_SHORT))
+    model = PPO("MlpPolicy", shared, n_steps=16, batch_size=48, n_epochs=1, device="cpu", seed=0)
+    model.learn(total_timesteps=2 * 12 * 16)
+    assert model.num_timesteps == 2 * 6 * 32

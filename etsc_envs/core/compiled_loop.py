@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from etsc_envs.core.jit import jit
+from etsc_envs.core.jit import closure_jit, jit
 
 LoopArrays = namedtuple(
     "LoopArrays",
@@ -145,7 +145,7 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
     failure = kernels.failure
     features = kernels.features
 
-    @jit
+    @closure_jit
     def step_row(
         i, actions, arrays, constants, h, n_steps, cost_scale, transmission_penalty, failure_cost
     ):
@@ -203,7 +203,7 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
                 -(costs[channel] + share) / cost_scale - transmission_penalty * sent[channel]
             )
 
-    @jit
+    @closure_jit
     def loop_step(
         actions,
         active,

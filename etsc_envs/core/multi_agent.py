@@ -62,6 +62,25 @@ def agent_metrics(
     return record
 
 
+def agent_observation_index(loop: EventTriggeredEnv) -> np.ndarray:
+    """Where each agent's observation sits in the loop's: row ``i`` holds the positions of
+    agent ``i``'s features followed by its transmission clock (``ValueError`` if the loop does
+    not provide what the module docstring asks)."""
+    n_agents = loop.n_channels
+    feature_names = tuple(loop.agent_feature_names)
+    n_features = len(feature_names)
+    if len(loop.agent_names) != n_agents:
+        raise ValueError(f"loop.agent_names must name {n_agents} agents (one per channel)")
+    if loop.observation_names[: n_agents * n_features] != agent_major_names(
+        feature_names, n_agents
+    ):
+        raise ValueError("the loop's observation must start with agent_major_names(...)")
+    clock_start = len(loop.observation_names) - n_agents
+    return np.array(
+        [[*range(i * n_features, (i + 1) * n_features), clock_start + i] for i in range(n_agents)]
+    )
+
+
 class EventTriggeredParallelEnv(ParallelEnv):
     """Decentralised transmit-or-hold decisions over one shared multi-channel loop.
 
@@ -83,26 +102,11 @@ class EventTriggeredParallelEnv(ParallelEnv):
 
     def __init__(self, loop: EventTriggeredEnv) -> None:
         self.loop = loop
-        n_agents = loop.n_channels
-        feature_names = tuple(loop.agent_feature_names)
-        n_features = len(feature_names)
-        if len(loop.agent_names) != n_agents:
-            raise ValueError(f"loop.agent_names must name {n_agents} agents (one per channel)")
-        if loop.observation_names[: n_agents * n_features] != agent_major_names(
-            feature_names, n_agents
-        ):
-            raise ValueError("the loop's observation must start with agent_major_names(...)")
         self.possible_agents = list(loop.agent_names)
         self.agents: list[str] = []
         self.render_mode = None
-        self.agent_observation_names = (*feature_names, CLOCK_NAME)
-        clock_start = len(loop.observation_names) - n_agents
-        self._index = np.array(
-            [
-                [*range(i * n_features, (i + 1) * n_features), clock_start + i]
-                for i in range(n_agents)
-            ]
-        )
+        self.agent_observation_names = (*loop.agent_feature_names, CLOCK_NAME)
+        self._index = agent_observation_index(loop)
         box = loop.observation_space
         self._observation_spaces = {
             agent: gym.spaces.Box(box.low[rows], box.high[rows], dtype=np.float32)

@@ -108,6 +108,9 @@ class EventTriggeredVectorEnv(VectorEnv):
         self._loop_step_entry = None
         self._actions = np.zeros((self.num_envs, first.n_channels), dtype=np.int64)
         self._needs_reset = np.ones(self.num_envs, dtype=bool)
+        self.channel_rewards = np.zeros((self.num_envs, first.n_channels))
+        """Each sub-environment's reward split by channel at the last step (taken before a
+        same-step reset), for training one policy per channel."""
 
     # ----------------------------------------------------------------- Gymnasium API
     def reset(
@@ -159,6 +162,7 @@ class EventTriggeredVectorEnv(VectorEnv):
         truncated = ~terminated & (arrays.step_index >= first.n_steps)
         ended = terminated | truncated
         rewards = arrays.reward.copy()
+        self.channel_rewards = arrays.channel_rewards.copy()
         infos: dict[str, Any] = {}
         for index in np.flatnonzero(ended):
             env = self.envs[index]
