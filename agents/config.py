@@ -26,6 +26,9 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``evaluation_env_kwargs: {}`` — env kwargs of that evaluation on top of the paper scenario
   (``randomize`` is always false there), e.g. a shorter ``horizon_s``;
 * ``tensorboard: true`` — write TensorBoard logs into ``out_dir/tensorboard``;
+* ``init_from: null`` — a model saved by an earlier run (``model.zip`` or a checkpoint) to
+  start from: its weights and, when saved beside it, its observation and return statistics
+  (a curriculum, e.g. short episodes first, then the paper's horizon or another λ);
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
   batches of a few dozen rows run fastest on one thread; more threads contend with the
   vector env's stepping threads (twice the steps per second with one thread, measured on the
@@ -70,6 +73,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "evaluation_env_kwargs": {},
     "tensorboard": True,
     "torch_threads": 1,
+    "init_from": None,
 }
 
 CONFIG_SET_ARGUMENTS = ("policy", "env", "seed")
@@ -96,6 +100,7 @@ class TrainConfig:
     evaluation_env_kwargs: dict[str, Any]
     tensorboard: bool
     torch_threads: int
+    init_from: str | None
 
     @property
     def algorithm_class(self) -> type[BaseAlgorithm]:
@@ -145,6 +150,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         ),
         tensorboard=_check_tensorboard(values["tensorboard"]),
         torch_threads=_check_positive_int("torch_threads", values["torch_threads"]),
+        init_from=_check_init_from(values["init_from"]),
     )
 
 
@@ -287,6 +293,17 @@ def _check_bool(key: str, value: Any) -> bool:
 def _check_non_negative_int(key: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 0:
         raise ValueError(f"config key {key!r} must be an integer >= 0, got {value!r}")
+    return value
+
+
+def _check_init_from(value: Any) -> str | None:
+    if value is None:
+        return None
+    if not isinstance(value, str) or not Path(value).is_file():
+        raise ValueError(
+            f"config key 'init_from' must be the path of a saved model (.zip) or null, "
+            f"got {value!r}"
+        )
     return value
 
 

@@ -76,19 +76,21 @@ def _row(result: dict[str, Any], keys: tuple[str, ...]) -> dict[str, Any]:
 
 
 def meets_goal(learned: dict[str, Any], paper: dict[str, Any]) -> dict[str, Any]:
-    """The goal's two ratios (learned over paper) and whether both hold without failures."""
-    cost_ratio = learned["mean_cost"] / paper["mean_cost"] if paper["mean_cost"] else None
-    transmission_ratio = (
-        learned["transmissions"] / paper["transmissions"] if paper["transmissions"] else None
-    )
+    """The goal's two ratios (learned over paper; ``None`` where the paper's value is 0) and
+    whether the goal holds: ``mean_cost`` at most ``1 + COST_TOLERANCE`` times the paper's (so
+    exactly 0 where the paper's is 0), at most ``1 - TRANSMISSION_SAVING`` times its
+    transmissions, and no failed episode."""
+    paper_cost, paper_sent = paper["mean_cost"], paper["transmissions"]
     met = (
-        cost_ratio is not None
-        and transmission_ratio is not None
-        and cost_ratio <= 1.0 + COST_TOLERANCE
-        and transmission_ratio <= 1.0 - TRANSMISSION_SAVING
+        learned["mean_cost"] <= paper_cost * (1.0 + COST_TOLERANCE)
+        and learned["transmissions"] <= paper_sent * (1.0 - TRANSMISSION_SAVING)
         and not learned["failures"]
     )
-    return {"cost_ratio": cost_ratio, "transmission_ratio": transmission_ratio, "met": met}
+    return {
+        "cost_ratio": learned["mean_cost"] / paper_cost if paper_cost else None,
+        "transmission_ratio": learned["transmissions"] / paper_sent if paper_sent else None,
+        "met": bool(met),
+    }
 
 
 def compare(

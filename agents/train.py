@@ -98,6 +98,8 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
             tensorboard_log=tensorboard_log,
             **config.hyperparameters,
         )
+        if config.init_from is not None:
+            model.set_parameters(config.init_from, device="cpu")
     else:
         model = config.algorithm_class.load(
             checkpoint, env=env, device="cpu", tensorboard_log=tensorboard_log
@@ -181,14 +183,34 @@ def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> Ve
         )
     if not (config.normalize_observations or config.normalize_rewards):
         return env
+    statistics = _start_statistics(config, checkpoint)
+    if statistics is None:
+        return VecNormalize(
+            env,
+            norm_obs=config.normalize_observations,
+            norm_reward=config.normalize_rewards,
+            gamma=config.hyperparameters.get("gamma", 0.99),
+        )
+    normalized = VecNormalize.load(str(statistics), env)
+    normalized.training = True
+    normalized.norm_obs = config.normalize_observations
+    normalized.norm_reward = config.normalize_rewards
+    normalized.gamma = config.hyperparameters.get("gamma", 0.99)
+    return normalized
+
+
+def _start_statistics(config: TrainConfig, checkpoint: Path | None) -> Path | None:
+    """The normalisation statistics training starts from: the resumed checkpoint's, else those
+    saved beside ``init_from`` (if any), else none (fresh statistics)."""
     if checkpoint is not None:
-        return VecNormalize.load(str(_checkpoint_statistics(checkpoint)), env)
-    return VecNormalize(
-        env,
-        norm_obs=config.normalize_observations,
-        norm_reward=config.normalize_rewards,
-        gamma=config.hyperparameters.get("gamma", 0.99),
-    )
+        return _checkpoint_statistics(checkpoint)
+    if config.init_from is None:
+        return None
+    model_path = Path(config.init_from)
+    candidates = [normalization_path(model_path)]
+    if model_path.stem.endswith("_steps"):
+        candidates.append(_checkpoint_statistics(model_path))
+    return next((candidate for candidate in candidates if candidate.is_file()), None)
 
 
 def _checkpoint_statistics(checkpoint: Path) -> Path:

@@ -153,6 +153,36 @@ def test_resume_continues_from_the_newest_checkpoint(tmp_path: Path) -> None:
     assert summary["timesteps"] < 320 + 128, "resuming does not start the count again"
 
 
+def test_init_from_starts_from_an_earlier_models_weights_and_statistics(tmp_path: Path) -> None:
+    import pickle
+
+    import numpy as np
+
+    from baselines.policies import normalization_path
+
+    first = tmp_path / "first"
+    assert main(["--config", str(write_config(tiny_config(first), tmp_path))]) == 0
+    second = tmp_path / "second"
+    config = tiny_config(second) | {"init_from": str(first / MODEL_FILE), "total_timesteps": 64}
+    config["hyperparameters"]["learning_rate"] = 0.0  # keep the weights as loaded
+    assert main(["--config", str(write_config(config, tmp_path))]) == 0
+    before = stable_baselines3.PPO.load(first / MODEL_FILE, device="cpu").policy.state_dict()
+    after = stable_baselines3.PPO.load(second / MODEL_FILE, device="cpu").policy.state_dict()
+    for name, weights in before.items():
+        assert np.array_equal(weights.numpy(), after[name].numpy()), name
+    statistics = [
+        pickle.loads(normalization_path(run / MODEL_FILE).read_bytes()).obs_rms.count
+        for run in (first, second)
+    ]
+    assert statistics[1] > statistics[0], "the statistics continue from the first run's"
+
+
+def test_init_from_must_be_a_saved_model(tmp_path: Path) -> None:
+    config = tiny_config(tmp_path / "run") | {"init_from": str(tmp_path / "missing.zip")}
+    with pytest.raises(ValueError, match="init_from"):
+        config_from_dict(config)
+
+
 def test_resume_without_checkpoints_is_a_clear_error(tmp_path: Path) -> None:
     config_path = write_config(tiny_config(tmp_path / "run"), tmp_path)
     with pytest.raises(SystemExit):
