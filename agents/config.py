@@ -29,6 +29,10 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``init_from: null`` — a model saved by an earlier run (``model.zip`` or a checkpoint) to
   start from: its weights and, when saved beside it, its observation and return statistics
   (a curriculum, e.g. short episodes first, then the paper's horizon or another λ);
+* ``imitation_steps: 0`` — before reinforcement, run the paper's trigger for that many steps
+  on the training envs and clone it into the policy (and its returns into the value
+  function; :mod:`agents.imitation`); 0 starts from a random policy;
+* ``imitation_epochs: 10`` — passes over those steps when cloning;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
   batches of a few dozen rows run fastest on one thread; more threads contend with the
   vector env's stepping threads (twice the steps per second with one thread, measured on the
@@ -74,6 +78,8 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "tensorboard": True,
     "torch_threads": 1,
     "init_from": None,
+    "imitation_steps": 0,
+    "imitation_epochs": 10,
 }
 
 CONFIG_SET_ARGUMENTS = ("policy", "env", "seed")
@@ -101,6 +107,8 @@ class TrainConfig:
     tensorboard: bool
     torch_threads: int
     init_from: str | None
+    imitation_steps: int
+    imitation_epochs: int
 
     @property
     def algorithm_class(self) -> type[BaseAlgorithm]:
@@ -125,6 +133,11 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     """Validate a config mapping and fill in the optional keys' defaults."""
     _check_key_set(raw)
     values = {**OPTIONAL_DEFAULTS, **raw}
+    if values["init_from"] is not None and values["imitation_steps"]:
+        raise ValueError(
+            "config keys 'init_from' and 'imitation_steps' exclude each other: a run starts "
+            "from an earlier model or from the cloned paper trigger, not both"
+        )
     algorithm = _check_algorithm(values["algorithm"])
     env_id = _check_env_id(values["env_id"])
     env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
@@ -151,6 +164,8 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         tensorboard=_check_tensorboard(values["tensorboard"]),
         torch_threads=_check_positive_int("torch_threads", values["torch_threads"]),
         init_from=_check_init_from(values["init_from"]),
+        imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
+        imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
     )
 
 

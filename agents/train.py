@@ -36,6 +36,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, Ve
 import etsc_envs
 from agents.config import TrainConfig, load_config
 from agents.evaluation import PaperComparisonCallback
+from agents.imitation import imitate_paper_trigger
 from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
 from baselines.policies import normalization_path
 
@@ -86,6 +87,7 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
     out_dir = Path(config.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     checkpoint = latest_checkpoint(out_dir / CHECKPOINT_DIR) if resume else None
+    imitation: dict[str, Any] | None = None
     if resume and checkpoint is None:
         raise ValueError(f"--resume: no checkpoint in {out_dir / CHECKPOINT_DIR}")
     env = make_training_env(config, checkpoint)
@@ -100,6 +102,14 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
         )
         if config.init_from is not None:
             model.set_parameters(config.init_from, device="cpu")
+        if config.imitation_steps:
+            imitation = imitate_paper_trigger(
+                model,
+                config.env_id,
+                config.env_kwargs,
+                config.imitation_steps,
+                config.imitation_epochs,
+            )
     else:
         model = config.algorithm_class.load(
             checkpoint, env=env, device="cpu", tensorboard_log=tensorboard_log
@@ -121,6 +131,7 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
     _write_config(config, out_dir / CONFIG_FILE)
     summary = _summary(config, model, metrics_callback, wall_time_s)
     summary["resumed_from"] = None if checkpoint is None else str(checkpoint)
+    summary["imitation"] = imitation
     (out_dir / SUMMARY_FILE).write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
     return out_dir
 

@@ -1,0 +1,139 @@
+"""Start a learned trigger from the paper's trigger: behaviour cloning before reinforcement.
+
+A random initial policy transmits at half of all sampling instants, and its first transmit-
+or-hold patterns are far from anything that keeps the loop accurate; with episodes of 10⁴–10⁵
+instants, reinforcement learning alone then spends most of its budget rediscovering what the
+paper's triggering rule already knows (in paper 004's loop, for example, PPO from scratch
+lost the inner mass to the cavity wall for millions of steps). Cloning first makes the policy
+act like the paper's rule, on the training distribution, and fits the value function to the
+returns that rule earns; PPO then trades transmissions against accuracy from there.
+
+:func:`imitate_paper_trigger` runs the paper's trigger on the training ``VecEnv`` (randomized
+scenarios, through the same normalisation wrapper, whose statistics it thereby initialises),
+then trains the policy's action head to reproduce its decisions (cross-entropy) and the value
+head to predict the discounted returns of the collected episodes.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import torch
+from gymnasium import spaces
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.vec_env import VecEnv, VecNormalize
+
+from baselines.cli import episode_setup
+
+
+def paper_trigger(env_id: str, env_kwargs: dict[str, Any]) -> Any:
+    """The paper's triggering rule for the observations of ``env_id`` (one agent's, for a
+    PettingZoo id), answering batches like an SB3 model."""
+    setup = episode_setup(env_id, env_kwargs)
+    policy = setup.make_policy("paper", {})
+    setup.env.close()
+    return policy
+
+
+def collect_demonstrations(
+    env: VecEnv, policy: Any, steps: int, gamma: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Run ``policy`` on ``env`` for ``steps`` transitions (summed over sub-environments).
+
+    Returns the observations the learner sees (normalised if ``env`` normalises), the
+    policy's actions, and the discounted returns from each transition to the end of its
+    episode or of the collection.
+    """
+    rollout = max(steps // env.num_envs, 1)
+    observation = env.reset()
+    episode_start = np.ones(env.num_envs, dtype=bool)
+    state = None
+    observations, actions, rewards, dones = [], [], [], []
+    for _ in range(rollout):
+        raw = env.get_original_obs() if isinstance(env, VecNormalize) else observation
+        action, state = policy.predict(raw, state=state, episode_start=episode_start)
+        observations.append(observation)
+        actions.append(action)
+        observation, reward, done, _ = env.step(action)
+        rewards.append(reward)
+        dones.append(done)
+        episode_start = done
+    returns = np.zeros((rollout, env.num_envs), dtype=np.float32)
+    following = np.zeros(env.num_envs, dtype=np.float32)
+    for index in range(rollout - 1, -1, -1):
+        following = rewards[index] + gamma * following * (1.0 - dones[index])
+        returns[index] = following
+    return (
+        np.concatenate(observations),
+        np.concatenate(actions),
+        returns.reshape(-1),
+    )
+
+
+def clone(
+    model: BaseAlgorithm,
+    observations: np.ndarray,
+    actions: np.ndarray,
+    returns: np.ndarray,
+    epochs: int,
+    batch_size: int,
+) -> dict[str, float]:
+    """Fit ``model``'s policy to the demonstrated ``actions`` (negative log-likelihood) and its
+    value head to ``returns`` (squared error, weighted as PPO's ``vf_coef``), with the model's
+    own optimiser. Returns the last epoch's mean losses and the policy's agreement with the
+    demonstrations (deterministic actions)."""
+    policy = model.policy
+    policy.set_training_mode(True)
+    device = policy.device
+    count = len(observations)
+    observation_tensor = torch.as_tensor(observations, device=device)
+    if isinstance(model.action_space, spaces.Discrete):  # as PPO's own update feeds them
+        action_tensor = torch.as_tensor(actions, device=device).long().flatten()
+    else:
+        action_tensor = torch.as_tensor(actions, device=device, dtype=torch.float32)
+    return_tensor = torch.as_tensor(returns, device=device)
+    value_weight = float(getattr(model, "vf_coef", 0.5))
+    generator = np.random.default_rng(0)
+    losses = {"action_loss": 0.0, "value_loss": 0.0}
+    for _ in range(epochs):
+        order = generator.permutation(count)
+        sums = {"action_loss": 0.0, "value_loss": 0.0}
+        for start in range(0, count, batch_size):
+            batch = order[start : start + batch_size]
+            values, log_prob, _ = policy.evaluate_actions(
+                observation_tensor[batch], action_tensor[batch]
+            )
+            action_loss = -log_prob.mean()
+            value_loss = torch.nn.functional.mse_loss(values.flatten(), return_tensor[batch])
+            loss = action_loss + value_weight * value_loss
+            policy.optimizer.zero_grad()
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(policy.parameters(), model.max_grad_norm)
+            policy.optimizer.step()
+            sums["action_loss"] += action_loss.item() * len(batch)
+            sums["value_loss"] += value_loss.item() * len(batch)
+        losses = {name: total / count for name, total in sums.items()}
+    policy.set_training_mode(False)
+    predicted, _ = policy.predict(observations, deterministic=True)
+    agreement = float(np.mean(predicted.reshape(actions.shape) == actions))
+    return {**losses, "agreement": agreement}
+
+
+def imitate_paper_trigger(
+    model: BaseAlgorithm, env_id: str, env_kwargs: dict[str, Any], steps: int, epochs: int
+) -> dict[str, Any]:
+    """Clone the paper's trigger into ``model`` (see the module docstring) from ``steps``
+    transitions on the model's own training env; returns the fit's summary."""
+    env = model.get_env()
+    gamma = float(getattr(model, "gamma", 0.99))
+    observations, actions, returns = collect_demonstrations(
+        env, paper_trigger(env_id, env_kwargs), steps, gamma
+    )
+    batch_size = int(getattr(model, "batch_size", 256))
+    summary = clone(model, observations, actions, returns, epochs, batch_size)
+    return {
+        "steps": len(observations),
+        "demonstrated_transmit_rate": float(np.mean(actions)),
+        **summary,
+    }
