@@ -1,7 +1,7 @@
 """Accuracy against transmissions: the paper's trigger, periodic sampling and learned triggers.
 
     python -m agents.pareto ENV_ID [--model PATH ...] [--env-arg k=v ...] [--seed S]
-                                   [--out DIR]
+                                   [--out DIR] [--reuse PARETO_JSON]
 
 Runs one episode of the paper scenario (``randomize`` off) for every point of three curves and
 plots ``mean_cost`` (the per-step accuracy cost the reward penalises) against the number of
@@ -14,7 +14,8 @@ transmissions:
   typically one per transmission penalty λ.
 
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
-``results/pareto/<env name>``).
+``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper and periodic curves of
+an earlier run (same id, kwargs and seed) and runs only the models.
 """
 
 from __future__ import annotations
@@ -98,18 +99,32 @@ def pareto(
     models: list[str],
     env_kwargs: dict[str, Any],
     seed: int = 0,
+    reuse: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """The three curves of the module docstring for ``env_id``."""
+    """The three curves of the module docstring for ``env_id``; with ``reuse`` (an earlier
+    result of the same id, kwargs and seed), its paper and periodic curves are kept and only
+    the models run."""
     if env_id not in PAPER_SWEEPS:
         raise ValueError(f"no Pareto sweep for {env_id}; known: {sorted(PAPER_SWEEPS)}")
+    if reuse is not None:
+        earlier = (reuse.get("env"), reuse.get("env_kwargs"), reuse.get("seed"))
+        if earlier != (env_id, env_kwargs, seed):
+            raise ValueError(
+                f"--reuse: that result is of (env, env_kwargs, seed) = {earlier}, "
+                f"not {(env_id, env_kwargs, seed)}"
+            )
     setup = episode_setup(env_id, {**env_kwargs, "randomize": False})
-    curves = {
-        "paper": [run_point(setup, "paper", args, seed) for args in PAPER_SWEEPS[env_id]()],
-        "periodic": [
-            run_point(setup, "periodic", {"every": every}, seed) for every in periodic_sweep(env_id)
-        ],
-        "learned": [run_point(setup, f"sb3:{path}", {}, seed) for path in models],
-    }
+    if reuse is None:
+        curves = {
+            "paper": [run_point(setup, "paper", args, seed) for args in PAPER_SWEEPS[env_id]()],
+            "periodic": [
+                run_point(setup, "periodic", {"every": every}, seed)
+                for every in periodic_sweep(env_id)
+            ],
+        }
+    else:
+        curves = {name: reuse["curves"][name] for name in ("paper", "periodic")}
+    curves["learned"] = [run_point(setup, f"sb3:{path}", {}, seed) for path in models]
     setup.env.close()
     return {"env": env_id, "env_kwargs": env_kwargs, "seed": seed, "curves": curves}
 
@@ -158,10 +173,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
     parser.add_argument("--seed", type=int, default=0, help="reset seed of every episode")
     parser.add_argument("--out", type=Path, help="output folder")
+    parser.add_argument(
+        "--reuse",
+        type=Path,
+        metavar="PARETO_JSON",
+        help="keep the paper and periodic curves of an earlier run; run only the models",
+    )
     args = parser.parse_args(argv)
     try:
         env_kwargs = parse_assignments(args.env_arg, "--env-arg")
-        result = pareto(args.env_id, args.model, env_kwargs, args.seed)
+        reuse = json.loads(args.reuse.read_text(encoding="utf-8")) if args.reuse else None
+        result = pareto(args.env_id, args.model, env_kwargs, args.seed, reuse)
     except ValueError as error:
         parser.error(str(error))
     out_dir = args.out or Path("results") / "pareto" / args.env_id.split("/")[-1]

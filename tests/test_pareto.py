@@ -40,3 +40,16 @@ def test_every_sweep_is_accepted_by_its_paper_trigger(env_id: str) -> None:
     for args in PAPER_SWEEPS[env_id]():
         setup.make_policy("paper", args)
     setup.env.close()
+
+
+def test_reuse_keeps_the_earlier_curves_and_checks_they_match(tmp_path: Path) -> None:
+    first = tmp_path / "first"
+    argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.05"]
+    assert main([*argv, "--out", str(first)]) == 0
+    earlier = json.loads((first / "pareto.json").read_text(encoding="utf-8"))
+    second = tmp_path / "second"
+    assert main([*argv, "--out", str(second), "--reuse", str(first / "pareto.json")]) == 0
+    again = json.loads((second / "pareto.json").read_text(encoding="utf-8"))
+    assert again["curves"] == earlier["curves"]
+    with pytest.raises(SystemExit):
+        main(["etsc/AttitudeTracking-v0", "--reuse", str(first / "pareto.json")])
