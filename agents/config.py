@@ -17,6 +17,10 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``out_dir`` — where the model, the resolved config and the summary are written;
 * ``normalize_observations: true`` — train on observations standardised by running
   statistics (SB3's ``VecNormalize``), saved beside the model for evaluation;
+* ``observation_clip: 10.0`` — normalised observations are clipped to ± this (SB3's
+  ``clip_obs``). The transmission clock is the reason to raise it: early in training, when
+  the policy transmits at most instants, its standard deviation is a few sampling periods, and
+  at a clip of 10 a policy could not tell a hold of 20 instants from one of 200;
 * ``normalize_rewards: false`` — also scale rewards by a running estimate of the return;
 * ``checkpoint_every: 0`` — save the model (and the statistics) every that many steps into
   ``out_dir/checkpoints``, from which ``--resume`` continues; 0 saves no checkpoints;
@@ -72,6 +76,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "seed": 0,
     "normalize_observations": True,
     "normalize_rewards": False,
+    "observation_clip": 10.0,
     "checkpoint_every": 0,
     "evaluation_every": 0,
     "evaluation_env_kwargs": {},
@@ -101,6 +106,7 @@ class TrainConfig:
     out_dir: str
     normalize_observations: bool
     normalize_rewards: bool
+    observation_clip: float
     checkpoint_every: int
     evaluation_every: int
     evaluation_env_kwargs: dict[str, Any]
@@ -156,6 +162,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
             "normalize_observations", values["normalize_observations"]
         ),
         normalize_rewards=_check_bool("normalize_rewards", values["normalize_rewards"]),
+        observation_clip=_check_positive_float("observation_clip", values["observation_clip"]),
         checkpoint_every=_check_non_negative_int("checkpoint_every", values["checkpoint_every"]),
         evaluation_every=_check_non_negative_int("evaluation_every", values["evaluation_every"]),
         evaluation_env_kwargs=_check_mapping(
@@ -277,6 +284,13 @@ def _reject_numeric_string(key: str, value: Any) -> None:
         f"config key {key!r}: {value!r} was read as a string; write a YAML number such as "
         f"{number!r} (PyYAML needs a dot and a signed exponent, e.g. 3.0e-4)"
     )
+
+
+def _check_positive_float(key: str, value: Any) -> float:
+    _reject_numeric_string(key, value)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise ValueError(f"config key '{key}' must be a positive number, got {value!r}")
+    return float(value)
 
 
 def _check_positive_int(key: str, value: Any) -> int:

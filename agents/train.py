@@ -200,12 +200,14 @@ def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> Ve
             env,
             norm_obs=config.normalize_observations,
             norm_reward=config.normalize_rewards,
+            clip_obs=config.observation_clip,
             gamma=config.hyperparameters.get("gamma", 0.99),
         )
     normalized = VecNormalize.load(str(statistics), env)
     normalized.training = True
     normalized.norm_obs = config.normalize_observations
     normalized.norm_reward = config.normalize_rewards
+    normalized.clip_obs = config.observation_clip
     normalized.gamma = config.hyperparameters.get("gamma", 0.99)
     return normalized
 

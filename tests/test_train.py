@@ -170,11 +170,11 @@ def test_init_from_starts_from_an_earlier_models_weights_and_statistics(tmp_path
     after = stable_baselines3.PPO.load(second / MODEL_FILE, device="cpu").policy.state_dict()
     for name, weights in before.items():
         assert np.array_equal(weights.numpy(), after[name].numpy()), name
-    statistics = [
-        pickle.loads(normalization_path(run / MODEL_FILE).read_bytes()).obs_rms.count
-        for run in (first, second)
-    ]
-    assert statistics[1] > statistics[0], "the statistics continue from the first run's"
+    first_statistics, second_statistics = (
+        pickle.loads(normalization_path(run / MODEL_FILE).read_bytes()) for run in (first, second)
+    )
+    assert second_statistics.obs_rms.count > first_statistics.obs_rms.count, "continued"
+    assert first_statistics.clip_obs == 10.0, "SB3's default clip unless configured"
 
 
 def test_init_from_must_be_a_saved_model(tmp_path: Path) -> None:
@@ -202,6 +202,9 @@ def test_config_rejects_dqn_for_a_multibinary_action(tmp_path: Path) -> None:
         ("checkpoint_every", -1, "'checkpoint_every' must be an integer >= 0"),
         ("normalize_observations", "yes", "'normalize_observations' must be true or false"),
         ("evaluation_env_kwargs", [1], "'evaluation_env_kwargs' must be a mapping"),
+        ("observation_clip", 0, "'observation_clip' must be a positive number"),
+        ("torch_threads", 0, "'torch_threads' must be"),
+        ("imitation_steps", -5, "'imitation_steps' must be an integer >= 0"),
     ],
 )
 def test_config_rejects_bad_training_options(tmp_path: Path, key, value, message) -> None:
