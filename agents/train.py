@@ -116,9 +116,10 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
         )
     metrics_callback = EpisodeMetricsCallback()
     start = time.perf_counter()
+    periodic = _periodic_callbacks(config, out_dir, env.num_envs)
     model.learn(
         total_timesteps=max(config.total_timesteps - model.num_timesteps, 0),
-        callback=CallbackList([metrics_callback, *_periodic_callbacks(config, out_dir)]),
+        callback=CallbackList([metrics_callback, *periodic]),
         progress_bar=_progress_bar_available(),
         reset_num_timesteps=checkpoint is None,
     )
@@ -145,13 +146,14 @@ def latest_checkpoint(folder: Path) -> Path | None:
     return checkpoints[-1] if checkpoints else None
 
 
-def _periodic_callbacks(config: TrainConfig, out_dir: Path) -> list[BaseCallback]:
-    """Checkpoints and evaluations against the paper trigger, as configured."""
+def _periodic_callbacks(config: TrainConfig, out_dir: Path, num_envs: int) -> list[BaseCallback]:
+    """Checkpoints and evaluations against the paper trigger, as configured (``num_envs``:
+    the training ``VecEnv``'s sub-environments, whose steps the intervals count)."""
     callbacks: list[BaseCallback] = []
     if config.checkpoint_every:
         callbacks.append(
             CheckpointCallback(
-                save_freq=max(config.checkpoint_every // config.n_envs, 1),
+                save_freq=max(config.checkpoint_every // num_envs, 1),
                 save_path=str(out_dir / CHECKPOINT_DIR),
                 name_prefix=CHECKPOINT_PREFIX,
                 save_vecnormalize=config.normalize_observations or config.normalize_rewards,
