@@ -18,9 +18,9 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``normalize_observations: true`` — train on observations standardised by running
   statistics (SB3's ``VecNormalize``), saved beside the model for evaluation;
 * ``observation_clip: 10.0`` — normalised observations are clipped to ± this (SB3's
-  ``clip_obs``). The transmission clock is the reason to raise it: early in training, when
-  the policy transmits at most instants, its standard deviation is a few sampling periods, and
-  at a clip of 10 a policy could not tell a hold of 20 instants from one of 200;
+  ``clip_obs``). It bounds the longest hold the policy can tell apart, at the transmission
+  clock's running mean plus ``observation_clip`` standard deviations; the statistics start
+  from the short holds of a random policy, so the shipped configs raise it out of the way;
 * ``normalize_rewards: false`` — also scale rewards by a running estimate of the return;
 * ``checkpoint_every: 0`` — save the model (and the statistics) every that many steps into
   ``out_dir/checkpoints``, from which ``--resume`` continues; 0 saves no checkpoints;

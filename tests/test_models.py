@@ -1,0 +1,53 @@
+"""The trained triggers shipped in ``models/`` and the rows of ``docs/results.md``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+import etsc_envs
+from baselines.evaluate import evaluate
+from baselines.policies import NormalizedModel, load_sb3, normalization_path
+
+ROOT = Path(__file__).parents[1]
+MODELS = sorted((ROOT / "models").glob("*_ppo.zip"))
+RESULTS = ROOT / "docs" / "results"
+
+
+def env_id_of(model: Path) -> str:
+    return "etsc/" + model.name.removesuffix("_ppo.zip")
+
+
+def short_episode(env_id: str) -> dict[str, float]:
+    return {"horizon_s": 60.0} if "Asteroid" in env_id else {"horizon_s": 0.05}
+
+
+def test_models_are_shipped_for_registered_ids() -> None:
+    assert MODELS, "models/ holds the trained triggers of docs/results.md"
+    known = set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
+    for model in MODELS:
+        assert env_id_of(model) in known, model.name
+        assert normalization_path(model).is_file(), f"statistics beside {model.name}"
+
+
+@pytest.mark.parametrize("model", MODELS, ids=lambda path: path.stem)
+def test_every_model_loads_with_its_statistics_and_runs(model: Path) -> None:
+    assert isinstance(load_sb3(model), NormalizedModel)
+    env_id = env_id_of(model)
+    result = evaluate(env_id, f"sb3:{model}", env_args=short_episode(env_id))
+    assert result["episodes"][0]["steps"] > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", MODELS, ids=lambda path: path.stem)
+def test_evaluate_reproduces_the_learned_row_of_the_results(model: Path) -> None:
+    env_id = env_id_of(model)
+    recorded = json.loads((RESULTS / model.stem / "results.json").read_text(encoding="utf-8"))
+    row = recorded["paper_scenario"]["learned"]
+    result = evaluate(env_id, f"sb3:{model}", env_args=recorded["env_args"])
+    assert result["mean"]["transmissions"] == row["transmissions"]
+    assert result["mean"]["mean_cost"] == pytest.approx(row["mean_cost"], rel=1e-9)
