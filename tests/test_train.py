@@ -48,6 +48,8 @@ def tiny_config(out_dir: Path, path: Path = SHIPPED_CONFIG) -> dict[str, Any]:
         evaluation_every=0,
         evaluation_env_kwargs=dict(short),
     )
+    if config.get("imitation_steps"):
+        config["imitation_steps"] = 128
     return config
 
 
