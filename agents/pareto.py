@@ -29,7 +29,7 @@ import matplotlib.pyplot as plt
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.evaluation import episode_summary
-from baselines.cli import EpisodeSetup, episode_setup, parse_assignments
+from baselines.cli import EpisodeSetup, episode_setup, limit_torch_threads, parse_assignments
 from baselines.plotting import save
 from baselines.triggers.asteroid import PAPER_ALPHA
 from baselines.triggers.attitude_tracking import PAPER_PSI
@@ -180,6 +180,7 @@ def main(argv: list[str] | None = None) -> int:
         help="keep the paper and periodic curves of an earlier run; run only the models",
     )
     args = parser.parse_args(argv)
+    limit_torch_threads()
     try:
         env_kwargs = parse_assignments(args.env_arg, "--env-arg")
         reuse = json.loads(args.reuse.read_text(encoding="utf-8")) if args.reuse else None

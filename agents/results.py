@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import etsc_envs
-from baselines.cli import episode_setup, parse_assignments
+from baselines.cli import episode_setup, limit_torch_threads, parse_assignments
 from baselines.episodes import to_jsonable
 from baselines.evaluate import evaluate
 
@@ -194,6 +194,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
     parser.add_argument("--out", help="output folder (default results/<env name>)")
     args = parser.parse_args(argv)
+    limit_torch_threads()
     if args.randomized_episodes < 0:
         parser.error(f"--randomized-episodes must be >= 0, got {args.randomized_episodes}")
     try:

@@ -19,6 +19,17 @@ from baselines.triggers import PAPER_TRIGGERS
 POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
 
 
+def limit_torch_threads() -> None:
+    """Run PyTorch on one thread when torch is installed. The command-line tools query a policy
+    with a batch of one observation per step; more threads only add synchronisation, and under
+    load they made a step several times slower."""
+    try:
+        import torch
+    except ImportError:
+        return
+    torch.set_num_threads(1)
+
+
 def parse_value(text: str) -> Any:
     """A command-line value: an int or float if it reads as one (``3e-5`` included, which YAML
     1.1 would keep as a string), else YAML (booleans, lists, strings)."""

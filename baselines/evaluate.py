@@ -16,7 +16,13 @@ from typing import Any
 
 import gymnasium as gym
 
-from baselines.cli import POLICY_CHOICES, episode_setup, parse_assignments, write_json
+from baselines.cli import (
+    POLICY_CHOICES,
+    episode_setup,
+    limit_torch_threads,
+    parse_assignments,
+    write_json,
+)
 from baselines.episodes import mean_record
 from baselines.plotting import plot_episode
 
@@ -86,6 +92,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", metavar="PATH|-", help="write the results as JSON")
     parser.add_argument("--plot", metavar="DIR", help="write one figure per episode")
     args = parser.parse_args(argv)
+    limit_torch_threads()
     try:
         result = evaluate(
             args.env_id,
