@@ -50,6 +50,7 @@ def tiny_config(out_dir: Path, path: Path = SHIPPED_CONFIG) -> dict[str, Any]:
     )
     if config.get("imitation_steps"):
         config["imitation_steps"] = 128
+    config["init_from"] = None  # a later stage's predecessor is not trained here
     return config
 
 
