@@ -130,7 +130,8 @@ def pareto(
 
 
 def plot(result: dict[str, Any], path: Path) -> None:
-    """``mean_cost`` against transmissions, one marker style per curve (log-log axes)."""
+    """``mean_cost`` against transmissions, one marker style per curve (log-log axes; the cost
+    axis is linear near zero when some cost is exactly zero)."""
     figure, axes = plt.subplots(figsize=(6.0, 4.5))
     styles = {"paper": "o-", "periodic": "s--", "learned": "*"}
     labels = {
@@ -151,7 +152,18 @@ def plot(result: dict[str, Any], path: Path) -> None:
             markersize=10 if name == "learned" else 5,
         )
     axes.set_xscale("log")
-    axes.set_yscale("log")
+    costs = [
+        point["mean_cost"]
+        for points in result["curves"].values()
+        for point in points
+        if point["failure"] is None
+    ]
+    positive = [cost for cost in costs if cost > 0]
+    if positive and len(positive) == len(costs):
+        axes.set_yscale("log")
+    else:  # a zero cost (paper 003 inside its shell) has no place on a log axis
+        axes.set_yscale("symlog", linthresh=min(positive, default=1.0))
+        axes.set_ylim(bottom=0.0)
     axes.set_xlabel("transmissions per episode")
     axes.set_ylabel("mean_cost (accuracy cost per step)")
     axes.set_title(f"{result['env']}: accuracy against communication", fontsize=10)
