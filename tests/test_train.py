@@ -177,7 +177,7 @@ def test_init_from_starts_from_an_earlier_models_weights_and_statistics(tmp_path
         pickle.loads(normalization_path(run / MODEL_FILE).read_bytes()) for run in (first, second)
     )
     assert second_statistics.obs_rms.count > first_statistics.obs_rms.count, "continued"
-    assert first_statistics.clip_obs == 10.0, "SB3's default clip unless configured"
+    assert second_statistics.clip_obs == config.get("observation_clip", 10.0), "as configured"
 
 
 def test_init_from_must_be_a_saved_model(tmp_path: Path) -> None:
