@@ -46,59 +46,27 @@ def unbatch_info(infos: dict[str, Any], index: int) -> dict[str, Any]:
     return single
 
 
-def _require_same_step_autoreset(vector_env: VectorEnv) -> None:
-    """``ValueError`` unless ``vector_env`` resets a finished sub-environment in its last step."""
-    mode = vector_env.metadata.get("autoreset_mode")
-    if mode != AutoresetMode.SAME_STEP:
-        raise ValueError(
-            f"vector_env must autoreset in the same step (autoreset_mode='same_step'), got {mode!r}"
-        )
+class _VectorEnvView(VecEnv):
+    """What both SB3 views of a same-step vector env share: the autoreset check, ``close``,
+    and attribute access (``get_attr``, ``set_attr``, ``env_method``) on the objects
+    :meth:`_targets` names for the chosen SB3 sub-environments."""
 
-
-class SB3VecEnvAdapter(VecEnv):
-    """SB3 ``VecEnv`` view of a Gymnasium ``VectorEnv`` that autoresets in the same step.
-
-    Args:
-        vector_env: the vector environment (``metadata["autoreset_mode"]`` must be
-            ``AutoresetMode.SAME_STEP``).
-
-    Attribute access (``get_attr``, ``set_attr``, ``env_method``) reaches the sub-environments
-    of a native vector env (its ``envs``) and the vector env itself otherwise.
-    """
-
-    def __init__(self, vector_env: VectorEnv) -> None:
-        _require_same_step_autoreset(vector_env)
+    def __init__(
+        self,
+        vector_env: VectorEnv,
+        num_envs: int,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+    ) -> None:
+        mode = vector_env.metadata.get("autoreset_mode")
+        if mode != AutoresetMode.SAME_STEP:
+            raise ValueError(
+                "vector_env must autoreset in the same step (autoreset_mode='same_step'), "
+                f"got {mode!r}"
+            )
         self.vector_env = vector_env
-        super().__init__(
-            vector_env.num_envs,
-            vector_env.single_observation_space,
-            vector_env.single_action_space,
-        )
+        super().__init__(num_envs, observation_space, action_space)
         self._actions: np.ndarray | None = None
-
-    # ----------------------------------------------------------------- VecEnv API
-    def reset(self) -> np.ndarray:
-        seeds = self._seeds if any(seed is not None for seed in self._seeds) else None
-        options = self._options[0] if self._options and self._options[0] else None
-        observations, infos = self.vector_env.reset(seed=seeds, options=options)
-        self.reset_infos = [unbatch_info(infos, index) for index in range(self.num_envs)]
-        self._reset_seeds()
-        self._reset_options()
-        return observations
-
-    def step_async(self, actions: np.ndarray) -> None:
-        self._actions = actions
-
-    def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
-        observations, rewards, terminated, truncated, infos = self.vector_env.step(self._actions)
-        dones = terminated | truncated
-        step_infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
-        for index in np.flatnonzero(dones):
-            info = unbatch_info(infos.get("final_info", {}), index)
-            info["terminal_observation"] = infos["final_obs"][index]
-            info["TimeLimit.truncated"] = bool(truncated[index] and not terminated[index])
-            step_infos[index] = info
-        return observations, rewards.astype(np.float32), dones, step_infos
 
     def close(self) -> None:
         self.vector_env.close()
@@ -124,6 +92,54 @@ class SB3VecEnvAdapter(VecEnv):
     def get_images(self) -> Sequence[np.ndarray | None]:
         return [None] * self.num_envs
 
+    def _targets(self, indices: Any) -> list[Any]:
+        """The object each chosen SB3 sub-environment's attributes live on."""
+        raise NotImplementedError
+
+
+class SB3VecEnvAdapter(_VectorEnvView):
+    """SB3 ``VecEnv`` view of a Gymnasium ``VectorEnv`` that autoresets in the same step.
+
+    Args:
+        vector_env: the vector environment (``metadata["autoreset_mode"]`` must be
+            ``AutoresetMode.SAME_STEP``).
+
+    Attribute access (``get_attr``, ``set_attr``, ``env_method``) reaches the sub-environments
+    of a native vector env (its ``envs``) and the vector env itself otherwise.
+    """
+
+    def __init__(self, vector_env: VectorEnv) -> None:
+        super().__init__(
+            vector_env,
+            vector_env.num_envs,
+            vector_env.single_observation_space,
+            vector_env.single_action_space,
+        )
+
+    # ----------------------------------------------------------------- VecEnv API
+    def reset(self) -> np.ndarray:
+        seeds = self._seeds if any(seed is not None for seed in self._seeds) else None
+        options = self._options[0] if self._options and self._options[0] else None
+        observations, infos = self.vector_env.reset(seed=seeds, options=options)
+        self.reset_infos = [unbatch_info(infos, index) for index in range(self.num_envs)]
+        self._reset_seeds()
+        self._reset_options()
+        return observations
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = actions
+
+    def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
+        observations, rewards, terminated, truncated, infos = self.vector_env.step(self._actions)
+        dones = terminated | truncated
+        step_infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
+        for index in np.flatnonzero(dones):
+            info = unbatch_info(infos.get("final_info", {}), index)
+            info["terminal_observation"] = infos["final_obs"][index]
+            info["TimeLimit.truncated"] = bool(truncated[index] and not terminated[index])
+            step_infos[index] = info
+        return observations, rewards.astype(np.float32), dones, step_infos
+
     # ----------------------------------------------------------------- internals
     def _targets(self, indices: Any) -> list[Any]:
         envs = getattr(self.vector_env, "envs", None)
@@ -133,20 +149,24 @@ class SB3VecEnvAdapter(VecEnv):
         return [envs[index] for index in chosen]
 
 
-def make_sb3_vec_env(env_id: str, num_envs: int, **env_kwargs: Any) -> SB3VecEnvAdapter:
-    """``num_envs`` copies of ``env_id`` as one SB3 ``VecEnv``: the id's native vector env
-    (same-step autoreset) behind :class:`SB3VecEnvAdapter`."""
-    vector_env = gym.make_vec(
+def _same_step_vector_env(env_id: str, num_envs: int, **env_kwargs: Any) -> VectorEnv:
+    """The native vector env of the Gymnasium id ``env_id``, autoresetting in the same step."""
+    return gym.make_vec(
         env_id,
         num_envs=num_envs,
         vectorization_mode="vector_entry_point",
         autoreset_mode=AutoresetMode.SAME_STEP,
         **env_kwargs,
     )
-    return SB3VecEnvAdapter(vector_env)
 
 
-class SharedPolicyVecEnv(VecEnv):
+def make_sb3_vec_env(env_id: str, num_envs: int, **env_kwargs: Any) -> SB3VecEnvAdapter:
+    """``num_envs`` copies of ``env_id`` as one SB3 ``VecEnv``: the id's native vector env
+    (same-step autoreset) behind :class:`SB3VecEnvAdapter`."""
+    return SB3VecEnvAdapter(_same_step_vector_env(env_id, num_envs, **env_kwargs))
+
+
+class SharedPolicyVecEnv(_VectorEnvView):
     """SB3 ``VecEnv`` in which every agent of a multi-channel loop is one sub-environment.
 
     Args:
@@ -161,19 +181,17 @@ class SharedPolicyVecEnv(VecEnv):
     """
 
     def __init__(self, vector_env: VectorEnv) -> None:
-        _require_same_step_autoreset(vector_env)
-        self.vector_env = vector_env
         loop = vector_env.envs[0]
         self.index = agent_observation_index(loop)
         self.n_agents, self.n_rows = loop.n_channels, vector_env.num_envs
         box = vector_env.single_observation_space
         rows = self.index[0]
         super().__init__(
+            vector_env,
             self.n_rows * self.n_agents,
             gym.spaces.Box(box.low[rows], box.high[rows], dtype=np.float32),
             gym.spaces.Discrete(2),
         )
-        self._actions: np.ndarray | None = None
 
     def reset(self) -> np.ndarray:
         seeds = self._seeds[: self.n_rows]
@@ -210,35 +228,11 @@ class SharedPolicyVecEnv(VecEnv):
                 step_infos[row * self.n_agents + agent] = info
         return self._agent_observations(observations), rewards, dones, step_infos
 
-    def close(self) -> None:
-        self.vector_env.close()
-
-    def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
-        return [getattr(env, attr_name) for env in self._row_envs(indices)]
-
-    def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
-        for env in self._row_envs(indices):
-            setattr(env, attr_name, value)
-
-    def env_method(
-        self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
-    ) -> list[Any]:
-        return [
-            getattr(env, method_name)(*method_args, **method_kwargs)
-            for env in self._row_envs(indices)
-        ]
-
-    def env_is_wrapped(self, wrapper_class: type[gym.Wrapper], indices: Any = None) -> list[bool]:
-        return [False] * len(self._get_indices(indices))
-
-    def get_images(self) -> Sequence[np.ndarray | None]:
-        return [None] * self.num_envs
-
     def _agent_observations(self, observations: np.ndarray) -> np.ndarray:
         """``(rows, loop observation)`` → ``(rows * N, agent observation)``, agent-minor."""
         return observations[:, self.index].reshape(-1, self.index.shape[1])
 
-    def _row_envs(self, indices: Any) -> list[Any]:
+    def _targets(self, indices: Any) -> list[Any]:
         """The loop (sub-environment of the vector env) each chosen agent belongs to."""
         chosen = self._get_indices(indices)
         return [self.vector_env.envs[index // self.n_agents] for index in chosen]
@@ -251,11 +245,5 @@ def make_shared_policy_vec_env(env_id: str, num_envs: int, **env_kwargs: Any) ->
         raise ValueError(
             f"{env_id!r} is not a PettingZoo id; known: {sorted(etsc_envs.PETTINGZOO_LOOP_IDS)}"
         )
-    vector_env = gym.make_vec(
-        etsc_envs.PETTINGZOO_LOOP_IDS[env_id],
-        num_envs=num_envs,
-        vectorization_mode="vector_entry_point",
-        autoreset_mode=AutoresetMode.SAME_STEP,
-        **env_kwargs,
-    )
-    return SharedPolicyVecEnv(vector_env)
+    loop_id = etsc_envs.PETTINGZOO_LOOP_IDS[env_id]
+    return SharedPolicyVecEnv(_same_step_vector_env(loop_id, num_envs, **env_kwargs))
