@@ -13,7 +13,9 @@ from numpy.testing import assert_allclose
 
 from etsc_envs.core.linalg import (
     fused_dot,
+    fused_matmul,
     fused_matvec3,
+    fused_matvec3_transposed,
     fused_multiply_add,
     matmul,
     matvec,
@@ -60,6 +62,16 @@ def _compiled_blas_matvec(matrix, vector):
 
 
 @njit
+def _compiled_blas_transposed_matvec(matrix, vector):
+    return matrix.T @ vector
+
+
+@njit
+def _compiled_blas_matmul(left, right):
+    return left @ right
+
+
+@njit
 def _compiled_fused_multiply_add(left, right, addend):
     return fused_multiply_add(left, right, addend)
 
@@ -76,6 +88,15 @@ def test_fused_products_return_the_bits_of_compiled_blas():
         assert fused_dot(vector * scale, vector) == _compiled_blas_dot(vector * scale, vector)
         assert fused_dot(quaternion, quaternion) == _compiled_blas_dot(quaternion, quaternion)
         assert np.array_equal(fused_matvec3(matrix, vector), _compiled_blas_matvec(matrix, vector))
+        assert np.array_equal(
+            fused_matvec3_transposed(matrix, vector),
+            _compiled_blas_transposed_matvec(matrix, vector),
+        )
+    for size in (3, 4, 6):
+        for _ in range(500):
+            left = rng.normal(size=(size, size)) * 10.0 ** rng.uniform(-8, 6, size=(size, 1))
+            right = rng.normal(size=(size, size))
+            assert np.array_equal(fused_matmul(left, right), _compiled_blas_matmul(left, right))
 
 
 def test_fused_multiply_add_rounds_once_compiled_and_in_python():

@@ -26,6 +26,7 @@ from etsc_envs.attitude_tracking.dynamics import (
     plant_derivative,
     tracking_error,
 )
+from etsc_envs.core import vec3
 from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts, stored_features
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
@@ -38,7 +39,7 @@ OBSERVER = slice(11, 17)  # [x̂_1, x̂_2] of the ET-ESO, eq. (16)
 MEASUREMENT = slice(17, 20)  # x_1 = z = ω_e + K q_ev at the current instant, eq. (8)
 RATE_ERROR = slice(20, 23)  # ω_e of eq. (4)
 TORQUE = slice(23, 26)  # u of eq. (24) over the last period
-FEATURES = slice(26, 39)  # the sensor's features, see sensor_features
+FEATURES = slice(26, 39)  # the sensor's features, see write_sensor_features
 ACCUMULATED = slice(39, 43)  # running sums: eq. (50) rate and attitude terms, eq. (52), Σ|u_i|
 INERTIA_PHASE = slice(43, 46)  # phases of ΔJ(t), drawn per episode when randomized
 DISTURBANCE_PHASE = slice(46, 49)  # phases of d(t)
@@ -56,74 +57,72 @@ integrate_plant = make_rk4_step(plant_derivative)
 
 
 @jit
-def sensor_features(
-    z: np.ndarray, x_hat: np.ndarray, xi: np.ndarray, gains: LoopGains
-) -> np.ndarray:
-    """What the sensor side knows at t_k, as ``[e_1, σ, z, x̂_2, Σ|α|/ε_min]``.
+def write_sensor_features(features: np.ndarray, z, x_hat: np.ndarray, xi, gains: LoopGains) -> None:
+    """Write what the sensor side knows at t_k into ``features``: ``[e_1, σ, z, x̂_2,
+    Σ|α|/ε_min]``.
 
     e_1 = (x_1 - x̂_1)/ε and σ = (x_1(t_k) - x_1(t))/ε are the inputs of eq. (27) (eq. 25 and
     section 2); the sensor mirrors the observer to know x̂.
     """
-    features = np.empty(N_FEATURES)
-    e1 = (z - x_hat[0:3]) / gains.epsilon
-    sigma = (xi - z) / gains.epsilon
-    features[0:3] = e1
-    features[3:6] = sigma
-    features[6:9] = z
-    features[9:12] = x_hat[3:6]
-    features[12] = trigger_statistic(e1, sigma, gains)
-    return features
+    epsilon = gains.epsilon
+    for i in range(3):
+        features[i] = (z[i] - x_hat[i]) / epsilon[i]
+        features[3 + i] = (xi[i] - z[i]) / epsilon[i]
+        features[6 + i] = z[i]
+        features[9 + i] = x_hat[3 + i]
+    features[12] = trigger_statistic(features[0:3], features[3:6], gains)
 
 
 @jit
 def tracking_accuracy(t: float, y: np.ndarray, model: PlantModel):
     """Integrands of eq. (50): (1/3) Σ|ω_i - ω_di| and (1/4) Σ|q_i - q_di|."""
-    rate_error = np.abs(y[4:7] - desired_rate(t, model)).sum() / 3.0
-    attitude_error = np.abs(y[0:4] - y[7:11]).sum() / 4.0
-    return rate_error, attitude_error
+    rate_error = vec3.absolute_sum(vec3.subtract(y[4:7], desired_rate(t, model))) / 3.0
+    attitude_error = 0.0
+    for i in range(4):
+        attitude_error += abs(y[i] - y[7 + i])
+    return rate_error, attitude_error / 4.0
+
+
+@jit
+def kinetic_energy_change(y_next: np.ndarray, y: np.ndarray) -> float:
+    """The step's term of eq. (52): Σ_i |½ ω_i(t_k + h)² - ½ ω_i(t_k)²|."""
+    change = 0.0
+    for i in range(4, 7):
+        change += abs(0.5 * y_next[i] ** 2 - 0.5 * y[i] ** 2)
+    return change
 
 
 @jit
 def closed_loop_step(
-    t: float,
-    h: float,
-    y: np.ndarray,
-    x_hat: np.ndarray,
-    xi: np.ndarray,
-    model: PlantModel,
-    gains: LoopGains,
+    t: float, h: float, state: np.ndarray, xi: np.ndarray, model: PlantModel, gains: LoopGains
 ):
-    """Advance plant, desired motion and ET-ESO from t_k to t_k + h with the held ξ.
+    """Advance plant, desired motion and ET-ESO of the state row from t_k to t_k + h with the
+    held ξ, and write the torque u(t_k) held over the period, z, ω_e and the sensor's features
+    at t_k + h.
 
-    Returns ``(y_next, x_hat_next, u, z_next, omega_e_next, features_next, rate_error,
-    attitude_error,
-    energy_increment)`` where the errors are the eq. (50) integrands at t_k + h and the energy
-    increment is the step's term of eq. (52).
+    Returns ``(rate_error, attitude_error, energy_increment)``: the eq. (50) integrands at
+    t_k + h and the step's term of eq. (52).
     """
+    x_hat = state[OBSERVER]
     torque = control_law(x_hat[0:3], x_hat[3:6], gains)
     d_hat1, d_hat2 = observer_derivative(x_hat[0:3], x_hat[3:6], xi, torque, gains)
-    x_hat_next = np.empty(6)
-    x_hat_next[0:3] = x_hat[0:3] + h * d_hat1
-    x_hat_next[3:6] = x_hat[3:6] + h * d_hat2
+    for i in range(3):
+        x_hat[i] = x_hat[i] + h * d_hat1[i]
+        x_hat[3 + i] = x_hat[3 + i] + h * d_hat2[i]
+    y = state[PLANT]
     y_next = integrate_plant(t, y, h, (torque, model))
     y_next[0:4] /= np.sqrt(fused_dot(y_next[0:4], y_next[0:4]))
     y_next[7:11] /= np.sqrt(fused_dot(y_next[7:11], y_next[7:11]))
+    energy_increment = kinetic_energy_change(y_next, y)
+    y[:] = y_next
     t_next = t + h
-    _, omega_e_next, z_next, _ = tracking_error(t_next, y_next, gains.attitude_gain, model)
-    features = sensor_features(z_next, x_hat_next, xi, gains)
-    rate_error, attitude_error = tracking_accuracy(t_next, y_next, model)
-    energy_increment = np.abs(0.5 * y_next[4:7] ** 2 - 0.5 * y[4:7] ** 2).sum()
-    return (
-        y_next,
-        x_hat_next,
-        torque,
-        z_next,
-        omega_e_next,
-        features,
-        rate_error,
-        attitude_error,
-        energy_increment,
-    )
+    _, omega_e, z, _ = tracking_error(t_next, y, gains.attitude_gain, model)
+    vec3.store(state[TORQUE], torque)
+    vec3.store(state[MEASUREMENT], z)
+    vec3.store(state[RATE_ERROR], omega_e)
+    write_sensor_features(state[FEATURES], z, x_hat, xi, gains)
+    rate_error, attitude_error = tracking_accuracy(t_next, y, model)
+    return rate_error, attitude_error, energy_increment
 
 
 @jit
@@ -162,31 +161,14 @@ def advance_loop(
     channel_costs: np.ndarray,
 ) -> None:
     """One sampling period in the state row; the cost is the eq. (50) integrands' sum."""
-    model = episode_model(state, constants)
-    (
-        plant,
-        observer,
-        torque,
-        measurement,
-        rate_error_vector,
-        features,
-        rate_error,
-        attitude_error,
-        energy_increment,
-    ) = closed_loop_step(
-        step_index * h, h, state[PLANT], state[OBSERVER], held[0], model, constants.gains
+    rate_error, attitude_error, energy_increment = closed_loop_step(
+        step_index * h, h, state, held[0], episode_model(state, constants), constants.gains
     )
-    state[PLANT] = plant
-    state[OBSERVER] = observer
-    state[TORQUE] = torque
-    state[MEASUREMENT] = measurement
-    state[RATE_ERROR] = rate_error_vector
-    state[FEATURES] = features
     accumulated = state[ACCUMULATED]
     accumulated[0] += rate_error
     accumulated[1] += attitude_error
     accumulated[2] += energy_increment
-    accumulated[3] += np.abs(torque).sum()
+    accumulated[3] += vec3.absolute_sum(state[TORQUE])
     channel_costs[0] = rate_error + attitude_error
 
 

@@ -11,15 +11,9 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import fused_matvec3
-from etsc_envs.core.rotations import (
-    attitude_matrix,
-    cross,
-    error_quaternion,
-    quat_kinematics,
-    solve3,
-)
+from etsc_envs.core.rotations import attitude_matrix, error_quaternion, quat_rate
 
 SINUSOID, SQUARE = 0, 1
 
@@ -45,7 +39,9 @@ PlantModel = namedtuple(
 @jit
 def inertia(t: float, model: PlantModel) -> np.ndarray:
     """True inertia J(t) = J0 + ΔJ(t) of section 4."""
-    variation = model.inertia_amplitude * np.sin(model.inertia_frequency * t + model.inertia_phase)
+    variation = vec3.sine_wave(
+        model.inertia_amplitude, model.inertia_frequency, t, model.inertia_phase
+    )
     inertia_now = model.nominal_inertia.copy()
     for axis in range(3):
         inertia_now[axis, axis] += variation[axis]
@@ -53,44 +49,48 @@ def inertia(t: float, model: PlantModel) -> np.ndarray:
 
 
 @jit
-def disturbance(t: float, model: PlantModel) -> np.ndarray:
+def disturbance(t: float, model: PlantModel) -> vec3.Vec3:
     """External torque d(t) of section 4, N·m."""
-    return model.disturbance_amplitude * np.sin(
-        model.disturbance_frequency * t + model.disturbance_phase
+    return vec3.sine_wave(
+        model.disturbance_amplitude, model.disturbance_frequency, t, model.disturbance_phase
     )
 
 
 @jit
-def desired_rate(t: float, model: PlantModel) -> np.ndarray:
+def desired_rate(t: float, model: PlantModel) -> vec3.Vec3:
     """ω_d(t): eq. (53) for the sinusoid, eqs. (54)-(55) for the square wave."""
     if model.reference_kind == SINUSOID:
-        return model.reference_amplitude * np.sin(model.reference_frequency * t)
+        amplitude, frequency = model.reference_amplitude, model.reference_frequency
+        return (
+            amplitude[0] * np.sin(frequency[0] * t),
+            amplitude[1] * np.sin(frequency[1] * t),
+            amplitude[2] * np.sin(frequency[2] * t),
+        )
     half_period_index = int(np.floor(t / model.reference_switch_period))
     sign = 1.0 if half_period_index % 2 == 0 else -1.0
-    return sign * model.reference_amplitude
+    return vec3.scale(sign, model.reference_amplitude)
 
 
 @jit
-def desired_rate_derivative(t: float, model: PlantModel) -> np.ndarray:
+def desired_rate_derivative(t: float, model: PlantModel) -> vec3.Vec3:
     """ω̇_d(t) (zero between the switches of the square wave)."""
     if model.reference_kind == SINUSOID:
+        amplitude, frequency = model.reference_amplitude, model.reference_frequency
         return (
-            model.reference_amplitude
-            * model.reference_frequency
-            * np.cos(model.reference_frequency * t)
+            amplitude[0] * frequency[0] * np.cos(frequency[0] * t),
+            amplitude[1] * frequency[1] * np.cos(frequency[1] * t),
+            amplitude[2] * frequency[2] * np.cos(frequency[2] * t),
         )
-    return np.zeros(3)
+    return (0.0, 0.0, 0.0)
 
 
 @jit
-def rate_derivative(
-    t: float, omega: np.ndarray, torque: np.ndarray, model: PlantModel
-) -> np.ndarray:
+def rate_derivative(t: float, omega, torque, model: PlantModel) -> vec3.Vec3:
     """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, with J = J(t)."""
     inertia_now = inertia(t, model)
-    return solve3(
-        inertia_now,
-        -cross(omega, fused_matvec3(inertia_now, omega)) + torque + disturbance(t, model),
+    gyroscopic = vec3.cross(omega, vec3.matvec(inertia_now, omega))
+    return vec3.solve(
+        inertia_now, vec3.add(vec3.add(vec3.negate(gyroscopic), torque), disturbance(t, model))
     )
 
 
@@ -98,10 +98,14 @@ def rate_derivative(
 def plant_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
     """ẏ for ``y = [q, ω, q_d]``: eq. (1) with the held torque ``args[0]``, and eq. (2)."""
     torque, model = args
+    omega = vec3.as_vec3(y[4:7])
+    attitude_rate = quat_rate(y[0:4], omega)
+    desired_attitude_rate = quat_rate(y[7:11], desired_rate(t, model))
     dy = np.empty(11)
-    dy[0:4] = quat_kinematics(y[0:4], y[4:7])
-    dy[4:7] = rate_derivative(t, y[4:7], torque, model)
-    dy[7:11] = quat_kinematics(y[7:11], desired_rate(t, model))
+    for i in range(4):
+        dy[i] = attitude_rate[i]
+        dy[7 + i] = desired_attitude_rate[i]
+    vec3.store(dy[4:7], rate_derivative(t, omega, torque, model))
     return dy
 
 
@@ -109,12 +113,12 @@ def plant_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
 def tracking_error(t: float, y: np.ndarray, attitude_gain: np.ndarray, model: PlantModel):
     """Error quaternion q_e and rate ω_e = ω - C ω_d of eq. (4), and z = ω_e + K q_ev (eq. 8).
 
-    Returns ``(q_e, omega_e, z, C)``.
+    Returns ``(q_e, omega_e, z, C)``: arrays q_e and C, 3-tuples ω_e and z.
     """
     q_e = error_quaternion(y[0:4], y[7:11])
     dcm = attitude_matrix(q_e)
-    omega_e = y[4:7] - fused_matvec3(dcm, desired_rate(t, model))
-    z = omega_e + attitude_gain * q_e[0:3]
+    omega_e = vec3.subtract(y[4:7], vec3.matvec(dcm, desired_rate(t, model)))
+    z = vec3.add(omega_e, vec3.multiply(attitude_gain, q_e))
     return q_e, omega_e, z, dcm
 
 
@@ -128,10 +132,14 @@ def total_disturbance(
     """
     q_e, omega_e, _, dcm = tracking_error(t, y, attitude_gain, model)
     omega_d = desired_rate(t, model)
-    z_dot = (
-        rate_derivative(t, y[4:7], torque, model)
-        + cross(omega_e, dcm @ omega_d)
-        - dcm @ desired_rate_derivative(t, model)
-        + attitude_gain * quat_kinematics(q_e, omega_e)[0:3]
+    z_dot = vec3.add(
+        vec3.subtract(
+            vec3.add(
+                rate_derivative(t, y[4:7], torque, model),
+                vec3.cross(omega_e, vec3.matvec(dcm, omega_d)),
+            ),
+            vec3.matvec(dcm, desired_rate_derivative(t, model)),
+        ),
+        vec3.multiply(attitude_gain, quat_rate(q_e, omega_e)),
     )
-    return z_dot - solve3(model.nominal_inertia, torque)
+    return vec3.to_array(vec3.subtract(z_dot, vec3.solve(model.nominal_inertia, torque)))

@@ -27,7 +27,7 @@ from etsc_envs.attitude_tracking.closed_loop import (
     TORQUE,
     LoopConstants,
     episode_model,
-    sensor_features,
+    write_sensor_features,
 )
 from etsc_envs.attitude_tracking.controller import LoopGains
 from etsc_envs.attitude_tracking.dynamics import (
@@ -174,8 +174,8 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
         )
         if p.observer_start == "first_measurement":
             state[OBSERVER][0:3] = state[MEASUREMENT]
-        state[FEATURES] = sensor_features(
-            state[MEASUREMENT], state[OBSERVER], state[MEASUREMENT], self.gains
+        write_sensor_features(
+            state[FEATURES], state[MEASUREMENT], state[OBSERVER], state[MEASUREMENT], self.gains
         )
 
     def _failure_message(self, code: int) -> str:
@@ -219,10 +219,10 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             "q": plant[0:4].copy(),
             "omega": plant[4:7].copy(),
             "q_d": plant[7:11].copy(),
-            "omega_d": desired_rate(t, model),
+            "omega_d": np.array(desired_rate(t, model)),
             "q_e": q_e,
-            "omega_e": omega_e,
-            "x1": z,
+            "omega_e": np.array(omega_e),
+            "x1": np.array(z),
             "x1_hat": state[OBSERVER][0:3].copy(),
             "x2": total_disturbance(t, plant, torque, self.gains.attitude_gain, model),
             "x2_hat": state[OBSERVER][3:6].copy(),

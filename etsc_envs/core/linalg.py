@@ -100,3 +100,32 @@ def fused_matvec3(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
         partial = fused_multiply_add(matrix[i, 0], vector[0], matrix[i, 1] * vector[1])
         out[i] = fused_multiply_add(matrix[i, 2], vector[2], partial)
     return out
+
+
+@jit
+def fused_matvec3_transposed(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
+    """``matrix.T @ vector`` for a C-ordered 3×3 matrix, each entry as ``fma(m_2j v_2,
+    fma(m_1j v_1, m_0j v_0))``: the same value, bit for bit, as the OpenBLAS ``dgemv`` NumPy's
+    ``@`` calls on the transposed view, without the call's overhead."""
+    out = np.empty(3)
+    for j in range(3):
+        partial = fused_multiply_add(matrix[1, j], vector[1], matrix[0, j] * vector[0])
+        out[j] = fused_multiply_add(matrix[2, j], vector[2], partial)
+    return out
+
+
+@jit
+def fused_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """``left @ right``, each entry the chain ``fma(l_in r_nj, ... fma(l_i1 r_1j, l_i0 r_0j))``:
+    the same value, bit for bit, as the OpenBLAS ``dgemm`` NumPy's ``@`` calls for the square
+    3×3, 4×4 and 6×6 products of the suite, without the call's overhead."""
+    rows, inner = left.shape
+    columns = right.shape[1]
+    out = np.empty((rows, columns))
+    for i in range(rows):
+        for j in range(columns):
+            total = left[i, 0] * right[0, j]
+            for k in range(1, inner):
+                total = fused_multiply_add(left[i, k], right[k, j], total)
+            out[i, j] = total
+    return out

@@ -18,8 +18,9 @@ All functions are compiled (see :mod:`etsc_envs.core.jit`) and take and return f
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import fused_dot, fused_matvec3
+from etsc_envs.core.linalg import fused_dot, fused_matmul, fused_matvec3
 
 _SMALL_ANGLE = 1e-8
 
@@ -40,32 +41,13 @@ def skew(a: np.ndarray) -> np.ndarray:
 @jit
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Vector product ``a × b`` of two 3-vectors."""
-    out = np.empty(3)
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
-    return out
+    return vec3.to_array(vec3.cross(a, b))
 
 
 @jit
 def solve3(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Solve the 3×3 linear system ``matrix · x = rhs`` by Cramer's rule."""
-    a = matrix
-    c00 = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
-    c01 = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
-    c02 = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
-    det = a[0, 0] * c00 + a[0, 1] * c01 + a[0, 2] * c02
-    inv = np.empty((3, 3))
-    inv[0, 0] = c00
-    inv[1, 0] = c01
-    inv[2, 0] = c02
-    inv[0, 1] = a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]
-    inv[1, 1] = a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]
-    inv[2, 1] = a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]
-    inv[0, 2] = a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]
-    inv[1, 2] = a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]
-    inv[2, 2] = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
-    return fused_matvec3(inv, rhs) / det
+    return vec3.to_array(vec3.solve(matrix, rhs))
 
 
 @jit
@@ -92,11 +74,20 @@ def quat_normalize(q: np.ndarray) -> np.ndarray:
 
 
 @jit
+def quat_rate(q, omega) -> tuple[float, float, float, float]:
+    """Quaternion rate ``q̇ = ½ q ⊗ [ω, 0]`` for the body-frame rate ω, as a tuple (see
+    :mod:`etsc_envs.core.vec3`); ``q`` and ``omega`` may be arrays or tuples."""
+    vector_rate = vec3.scale(0.5, vec3.add(vec3.scale(q[3], omega), vec3.cross(q, omega)))
+    return (vector_rate[0], vector_rate[1], vector_rate[2], -0.5 * vec3.dot(q, omega))
+
+
+@jit
 def quat_kinematics(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Quaternion rate ``q̇ = ½ q ⊗ [ω, 0]`` for the body-frame rate ω (eq. (1)/(2) of 002)."""
+    rate = quat_rate(q, omega)
     out = np.empty(4)
-    out[:3] = 0.5 * (q[3] * omega + cross(q[:3], omega))
-    out[3] = -0.5 * fused_dot(q[:3], omega)
+    for i in range(4):
+        out[i] = rate[i]
     return out
 
 
@@ -128,7 +119,7 @@ def attitude_matrix(q: np.ndarray) -> np.ndarray:
 @jit
 def quat_from_rotation_vector(phi: np.ndarray) -> np.ndarray:
     """Unit quaternion of the rotation by angle ``‖φ‖`` about ``φ/‖φ‖``."""
-    angle = np.sqrt(phi @ phi)
+    angle = np.sqrt(fused_dot(phi, phi))
     out = np.empty(4)
     if angle < _SMALL_ANGLE:
         out[:3] = 0.5 * phi
@@ -148,11 +139,15 @@ def _one_minus_cos_over_sq(angle: float) -> float:
 @jit
 def so3_exp(phi: np.ndarray) -> np.ndarray:
     """Rotation matrix ``exp(φ^×)`` (Rodrigues' formula)."""
-    angle = np.sqrt(phi @ phi)
+    angle = np.sqrt(fused_dot(phi, phi))
     phi_x = skew(phi)
     if angle < _SMALL_ANGLE:
-        return np.eye(3) + phi_x + 0.5 * phi_x @ phi_x
-    return np.eye(3) + np.sin(angle) / angle * phi_x + _one_minus_cos_over_sq(angle) * phi_x @ phi_x
+        return np.eye(3) + phi_x + fused_matmul(0.5 * phi_x, phi_x)
+    return (
+        np.eye(3)
+        + np.sin(angle) / angle * phi_x
+        + fused_matmul(_one_minus_cos_over_sq(angle) * phi_x, phi_x)
+    )
 
 
 @jit
@@ -170,7 +165,7 @@ def so3_log(rotation: np.ndarray) -> np.ndarray:
             rotation[1, 0] - rotation[0, 1],
         ]
     )
-    sin_angle = np.sqrt(axis_sin @ axis_sin)
+    sin_angle = np.sqrt(fused_dot(axis_sin, axis_sin))
     angle = np.arctan2(sin_angle, cos_angle)
     if angle < 1e-6:
         return axis_sin
@@ -188,16 +183,16 @@ def so3_log(rotation: np.ndarray) -> np.ndarray:
 @jit
 def so3_left_jacobian(phi: np.ndarray) -> np.ndarray:
     """Left Jacobian of SO(3), the map from twist to translation in :func:`se3_exp`."""
-    angle = np.sqrt(phi @ phi)
+    angle = np.sqrt(fused_dot(phi, phi))
     phi_x = skew(phi)
     if angle < _SMALL_ANGLE:
-        return np.eye(3) + 0.5 * phi_x + phi_x @ phi_x / 6.0
+        return np.eye(3) + 0.5 * phi_x + fused_matmul(phi_x, phi_x) / 6.0
     if angle < 0.1:  # (θ - sin θ)/θ³ by its series: the closed form cancels to ~1e-16/θ²
         a2 = angle * angle
         third = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0 - a2 * a2 * a2 / 362880.0
     else:
         third = (angle - np.sin(angle)) / angle**3
-    return np.eye(3) + _one_minus_cos_over_sq(angle) * phi_x + third * phi_x @ phi_x
+    return np.eye(3) + _one_minus_cos_over_sq(angle) * phi_x + fused_matmul(third * phi_x, phi_x)
 
 
 @jit
@@ -225,7 +220,7 @@ def se3_inverse(g: np.ndarray) -> np.ndarray:
     out = np.eye(4)
     rotation_t = np.ascontiguousarray(g[:3, :3].T)
     out[:3, :3] = rotation_t
-    out[:3, 3] = -rotation_t @ np.ascontiguousarray(g[:3, 3])
+    out[:3, 3] = fused_matvec3(-rotation_t, g[:3, 3])
     return out
 
 
@@ -309,7 +304,7 @@ def se3_adjoint(g: np.ndarray) -> np.ndarray:
     out = np.zeros((6, 6))
     out[:3, :3] = rotation
     out[3:, 3:] = rotation
-    out[3:, :3] = skew(np.ascontiguousarray(g[:3, 3])) @ rotation
+    out[3:, :3] = fused_matmul(skew(g[:3, 3]), rotation)
     return out
 
 
@@ -342,14 +337,14 @@ def so3_right_jacobian_inverse(phi: np.ndarray) -> np.ndarray:
     It maps a body-frame rate to the rate of the exponential coordinates:
     ``Ṙ = R ω^×`` with ``R = exp(φ^×)`` gives ``φ̇ = J_r⁻¹(φ) ω``.
     """
-    angle = np.sqrt(phi @ phi)
+    angle = np.sqrt(fused_dot(phi, phi))
     phi_x = skew(phi)
     if angle < 0.1:
         a2 = angle * angle
         coefficient = 1.0 / 12.0 + a2 / 720.0 + a2 * a2 / 30240.0 + a2 * a2 * a2 / 1209600.0
     else:
         coefficient = 1.0 / angle**2 - (1.0 + np.cos(angle)) / (2.0 * angle * np.sin(angle))
-    return np.eye(3) + 0.5 * phi_x + coefficient * phi_x @ phi_x
+    return np.eye(3) + 0.5 * phi_x + fused_matmul(coefficient * phi_x, phi_x)
 
 
 @jit
@@ -359,7 +354,7 @@ def se3_left_jacobian_coupling(phi: np.ndarray, rho: np.ndarray) -> np.ndarray:
     ``J_l(ξ) = [[J_l(φ), 0], [Q(φ, ρ), J_l(φ)]]`` for ``ξ = [φ, ρ]``; series coefficients are
     used below θ = 0.1, where the closed forms lose digits to cancellation.
     """
-    angle = np.sqrt(phi @ phi)
+    angle = np.sqrt(fused_dot(phi, phi))
     a2 = angle * angle
     if angle < 0.1:
         c1 = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0 - a2 * a2 * a2 / 362880.0
@@ -372,15 +367,16 @@ def se3_left_jacobian_coupling(phi: np.ndarray, rho: np.ndarray) -> np.ndarray:
         c3 = (2.0 * angle - 3.0 * s + angle * c) / (2.0 * a2 * a2 * angle)
     p = skew(phi)
     r = skew(rho)
-    pr = p @ r
-    rp = r @ p
-    prp = pr @ p
-    pp = p @ p
+    pr = fused_matmul(p, r)
+    rp = fused_matmul(r, p)
+    prp = fused_matmul(pr, p)
+    pp = fused_matmul(p, p)
+    ppr = fused_matmul(pp, r)
     return (
         0.5 * r
         + c1 * (pr + rp + prp)
-        + c2 * (pp @ r + rp @ p - 3.0 * prp)
-        + c3 * (prp @ p + pp @ r @ p)
+        + c2 * (ppr + fused_matmul(rp, p) - 3.0 * prp)
+        + c3 * (fused_matmul(prp, p) + fused_matmul(ppr, p))
     )
 
 
@@ -397,7 +393,7 @@ def se3_right_jacobian_inverse(xi: np.ndarray) -> np.ndarray:
     out = np.zeros((6, 6))
     out[:3, :3] = a
     out[3:, 3:] = a
-    out[3:, :3] = -a @ se3_left_jacobian_coupling(-phi, -rho) @ a
+    out[3:, :3] = fused_matmul(fused_matmul(-a, se3_left_jacobian_coupling(-phi, -rho)), a)
     return out
 
 

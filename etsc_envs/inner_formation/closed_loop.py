@@ -14,9 +14,11 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts, stored_features
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
+from etsc_envs.core.linalg import fused_dot
 from etsc_envs.inner_formation.controller import (
     ObserverFeedback,
     control_law,
@@ -32,7 +34,7 @@ N_FEATURES = 15
 
 LOOP = slice(0, 15)  # y = [r, ṙ, ζ, ψ, φ] of eqs. (1) and (3)
 CONTROL = slice(15, 18)  # u of eq. (16) at the current instant
-FEATURES = slice(18, 33)  # the sensor's features, see sensor_features
+FEATURES = slice(18, 33)  # the sensor's features, see write_sensor_features
 DISTURBANCE_PHASE = slice(33, 36)  # the p_i of Δa, drawn per episode when randomized
 STEADY_ERROR_MAX = slice(36, 45)  # steady-window maxima: |r - ζ|, |ṙ - ψ|, |h - φ| (3 axes each)
 STEADY_OFFSET_MAX = 45  # steady-window maximum of ‖r‖
@@ -61,10 +63,17 @@ def loop_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
     held_position, model, design = args
     estimate = y[6:15]
     control = control_law(estimate, design)
+    acceleration = vec3.add(lumped_term(t, y[0:3], y[3:6], model), control)
+    position_rate, velocity_rate, disturbance_rate = observer_derivative(
+        estimate, held_position, control, design
+    )
     dy = np.empty(15)
-    dy[0:3] = y[3:6]
-    dy[3:6] = lumped_term(t, y[0:3], y[3:6], model) + control
-    dy[6:15] = observer_derivative(estimate, held_position, control, design)
+    for axis in range(3):
+        dy[axis] = y[3 + axis]
+        dy[3 + axis] = acceleration[axis]
+        dy[6 + axis] = position_rate[axis]
+        dy[9 + axis] = velocity_rate[axis]
+        dy[12 + axis] = disturbance_rate[axis]
     return dy
 
 
@@ -72,66 +81,55 @@ integrate_loop = make_rk4_step(loop_derivative)
 
 
 @jit
-def estimation_errors(t: float, y: np.ndarray, control: np.ndarray, model: RelativeMotionModel):
+def estimation_errors(t: float, y: np.ndarray, control, model: RelativeMotionModel):
     """|r - ζ|, |ṙ - ψ|, |h - φ| per axis (the left sides of eqs. 8-10), and ḣ, given the
-    feedback ``control`` of eq. (16) at ``y``."""
+    feedback ``control`` of eq. (16) at ``y``; 3-tuples."""
     lumped = lumped_term(t, y[0:3], y[3:6], model)
-    rate = lumped_term_rate(t, y[0:3], y[3:6], lumped + control, model)
-    return (
-        np.abs(y[0:3] - y[6:9]),
-        np.abs(y[3:6] - y[9:12]),
-        np.abs(lumped - y[12:15]),
-        rate,
-    )
+    rate = lumped_term_rate(t, y[0:3], y[3:6], vec3.add(lumped, control), model)
+    position_error = (abs(y[0] - y[6]), abs(y[1] - y[7]), abs(y[2] - y[8]))
+    velocity_error = (abs(y[3] - y[9]), abs(y[4] - y[10]), abs(y[5] - y[11]))
+    disturbance_error = (abs(lumped[0] - y[12]), abs(lumped[1] - y[13]), abs(lumped[2] - y[14]))
+    return position_error, velocity_error, disturbance_error, rate
 
 
 @jit
-def sensor_features(y: np.ndarray, held_position: np.ndarray) -> np.ndarray:
-    """``[r(t) - r(t_k), r, ζ, ψ, φ]``: what eqs. (4)-(6) read, the measurement, the estimates."""
-    features = np.empty(N_FEATURES)
-    features[0:3] = y[0:3] - held_position
-    features[3:6] = y[0:3]
+def write_sensor_features(features: np.ndarray, y: np.ndarray, held_position) -> None:
+    """Write ``[r(t) - r(t_k), r, ζ, ψ, φ]`` into ``features``: what eqs. (4)-(6) read, the
+    measurement, the estimates."""
+    for axis in range(3):
+        features[axis] = y[axis] - held_position[axis]
+        features[3 + axis] = y[axis]
     features[6:15] = y[6:15]
-    return features
 
 
 @jit
 def closed_loop_step(
     t: float,
     h: float,
-    y: np.ndarray,
+    state: np.ndarray,
     held_position: np.ndarray,
     model: RelativeMotionModel,
     design: ObserverFeedback,
 ):
-    """Advance plant, observers and feedback from t_k to t_k + h with r(t_k) held.
+    """Advance plant, observers and feedback of the state row from t_k to t_k + h with r(t_k)
+    held, and write the feedback u and the sensor's features at t_k + h.
 
-    Returns ``(y_next, features_next, position_error, velocity_error, disturbance_error,
-    lumped_rate, control)`` at t_k + h, the errors being the per-axis left sides of (8)-(10).
+    Returns ``(position_error, velocity_error, disturbance_error, lumped_rate)`` at t_k + h,
+    the errors being the per-axis left sides of (8)-(10).
     """
-    y_next = integrate_loop(t, y, h, (held_position, model, design))
-    t_next = t + h
-    control = control_law(y_next[6:15], design)
-    position_error, velocity_error, disturbance_error, lumped_rate = estimation_errors(
-        t_next, y_next, control, model
-    )
-    features = sensor_features(y_next, held_position)
-    return (
-        y_next,
-        features,
-        position_error,
-        velocity_error,
-        disturbance_error,
-        lumped_rate,
-        control,
-    )
+    loop = state[LOOP]
+    loop[:] = integrate_loop(t, loop, h, (held_position, model, design))
+    control = control_law(loop[6:15], design)
+    vec3.store(state[CONTROL], control)
+    write_sensor_features(state[FEATURES], loop, held_position)
+    return estimation_errors(t + h, loop, control, model)
 
 
 @jit
 def offset_norm(state: np.ndarray) -> float:
     """‖r‖, the inner mass's distance from the cavity's centre (m)."""
     position = state[0:3]
-    return np.sqrt(position @ position)
+    return np.sqrt(fused_dot(position, position))
 
 
 @jit
@@ -168,28 +166,26 @@ def record_retransmissions(state: np.ndarray, sent: np.ndarray) -> None:
 
 
 @jit
-def record_extremes(state: np.ndarray, lumped_rate: np.ndarray) -> None:
+def record_extremes(state: np.ndarray, lumped_rate) -> None:
     """Raise the episode maxima of |r_i(t) - r_i(t_k)|, |r_i|, |ṙ_i| and |ḣ_i|."""
     sampling_error = state[SAMPLING_ERROR_MAX]
-    sampling_error[:] = np.maximum(sampling_error, np.abs(state[FEATURES][0:3]))
+    features = state[FEATURES]
     extremes = state[EXTREMES]
-    extremes[0:3] = np.maximum(extremes[0:3], np.abs(state[0:3]))
-    extremes[3:6] = np.maximum(extremes[3:6], np.abs(state[3:6]))
-    extremes[6:9] = np.maximum(extremes[6:9], np.abs(lumped_rate))
+    for axis in range(3):
+        sampling_error[axis] = max(sampling_error[axis], abs(features[axis]))
+        extremes[axis] = max(extremes[axis], abs(state[axis]))
+        extremes[3 + axis] = max(extremes[3 + axis], abs(state[3 + axis]))
+        extremes[6 + axis] = max(extremes[6 + axis], abs(lumped_rate[axis]))
 
 
 @jit
-def record_steady(
-    state: np.ndarray,
-    position_error: np.ndarray,
-    velocity_error: np.ndarray,
-    disturbance_error: np.ndarray,
-) -> None:
+def record_steady(state: np.ndarray, position_error, velocity_error, disturbance_error) -> None:
     """Raise the steady-window maxima of the left sides of (8)-(10) and of ‖r‖."""
     steady = state[STEADY_ERROR_MAX]
-    steady[0:3] = np.maximum(steady[0:3], position_error)
-    steady[3:6] = np.maximum(steady[3:6], velocity_error)
-    steady[6:9] = np.maximum(steady[6:9], disturbance_error)
+    for axis in range(3):
+        steady[axis] = max(steady[axis], position_error[axis])
+        steady[3 + axis] = max(steady[3 + axis], velocity_error[axis])
+        steady[6 + axis] = max(steady[6 + axis], disturbance_error[axis])
     state[STEADY_OFFSET_MAX] = max(state[STEADY_OFFSET_MAX], offset_norm(state))
 
 
@@ -205,30 +201,20 @@ def advance_loop(
 ) -> None:
     """One sampling period in the state row; axis i's cost is |r_i| + |r_i - ζ_i| (m)."""
     record_retransmissions(state, sent)
-    (
-        loop,
-        features,
-        position_error,
-        velocity_error,
-        disturbance_error,
-        lumped_rate,
-        control,
-    ) = closed_loop_step(
+    position_error, velocity_error, disturbance_error, lumped_rate = closed_loop_step(
         step_index * h,
         h,
-        state[LOOP],
+        state,
         held[:, 0],
         episode_model(state, constants),
         constants.design,
     )
-    state[LOOP] = loop
-    state[FEATURES] = features
-    state[CONTROL] = control
     record_extremes(state, lumped_rate)
     if step_index + 1 > constants.steady_start_step:
         record_steady(state, position_error, velocity_error, disturbance_error)
-    state[CONTROL_NORM_SUM] += np.sqrt(control @ control)
-    channel_costs[:] = np.abs(loop[0:3]) + position_error
+    state[CONTROL_NORM_SUM] += np.sqrt(vec3.dot(state[CONTROL], state[CONTROL]))
+    for axis in range(3):
+        channel_costs[axis] = abs(state[axis]) + position_error[axis]
 
 
 @jit

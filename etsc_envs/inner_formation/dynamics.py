@@ -10,8 +10,8 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.rotations import cross
 
 RelativeMotionModel = namedtuple(
     "RelativeMotionModel",
@@ -26,29 +26,36 @@ RelativeMotionModel = namedtuple(
 
 
 @jit
-def disturbance(t: float, model: RelativeMotionModel) -> np.ndarray:
+def disturbance(t: float, model: RelativeMotionModel) -> vec3.Vec3:
     """Δa(t) of section 4, m/s²."""
-    return model.disturbance_amplitude * np.sin(
-        model.disturbance_frequency * t + model.disturbance_phase
+    return vec3.sine_wave(
+        model.disturbance_amplitude, model.disturbance_frequency, t, model.disturbance_phase
     )
 
 
 @jit
-def lumped_term(t: float, position: np.ndarray, velocity: np.ndarray, model) -> np.ndarray:
+def lumped_term(t: float, position, velocity, model) -> vec3.Vec3:
     """h(t) of eq. (2): Δa - 2 n × ṙ - n × (n × r) (ṅ = 0)."""
     n = model.orbit_rate
-    return disturbance(t, model) - 2.0 * cross(n, velocity) - cross(n, cross(n, position))
+    coriolis = vec3.scale(2.0, vec3.cross(n, velocity))
+    centripetal = vec3.cross(n, vec3.cross(n, position))
+    return vec3.subtract(vec3.subtract(disturbance(t, model), coriolis), centripetal)
 
 
 @jit
-def lumped_term_rate(
-    t: float, position: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, model
-) -> np.ndarray:
+def lumped_term_rate(t: float, position, velocity, acceleration, model) -> vec3.Vec3:
     """ḣ(t), the quantity Assumption 1 bounds by M_i."""
     n = model.orbit_rate
-    disturbance_rate = (
-        model.disturbance_amplitude
-        * model.disturbance_frequency
-        * np.cos(model.disturbance_frequency * t + model.disturbance_phase)
+    amplitude, frequency, phase = (
+        model.disturbance_amplitude,
+        model.disturbance_frequency,
+        model.disturbance_phase,
     )
-    return disturbance_rate - 2.0 * cross(n, acceleration) - cross(n, cross(n, velocity))
+    disturbance_rate = (
+        amplitude[0] * frequency[0] * np.cos(frequency[0] * t + phase[0]),
+        amplitude[1] * frequency[1] * np.cos(frequency[1] * t + phase[1]),
+        amplitude[2] * frequency[2] * np.cos(frequency[2] * t + phase[2]),
+    )
+    coriolis_rate = vec3.scale(2.0, vec3.cross(n, acceleration))
+    centripetal_rate = vec3.cross(n, vec3.cross(n, velocity))
+    return vec3.subtract(vec3.subtract(disturbance_rate, coriolis_rate), centripetal_rate)

@@ -32,7 +32,7 @@ from etsc_envs.inner_formation.closed_loop import (
     LoopConstants,
     episode_model,
     offset_norm,
-    sensor_features,
+    write_sensor_features,
 )
 from etsc_envs.inner_formation.controller import ObserverFeedback
 from etsc_envs.inner_formation.design import estimation_bounds, zeno_bound_s
@@ -162,7 +162,7 @@ class InnerFormationEnv(EventTriggeredEnv):
         loop[3:6] = velocity
         if p.observer_start == "first_measurement":
             loop[6:9] = position
-        state[FEATURES] = sensor_features(loop, position)
+        write_sensor_features(state[FEATURES], loop, position)
         state[RETRANSMIT_ERROR_MIN] = np.inf
 
     def _failure_message(self, code: int) -> str:
@@ -220,7 +220,7 @@ class InnerFormationEnv(EventTriggeredEnv):
             "position_estimate": loop[6:9].copy(),
             "velocity_estimate": loop[9:12].copy(),
             "disturbance_estimate": loop[12:15].copy(),
-            "lumped_disturbance": lumped_term(t, loop[0:3], loop[3:6], self.model),
+            "lumped_disturbance": np.array(lumped_term(t, loop[0:3], loop[3:6], self.model)),
             "held_position": self.held[:, 0].copy(),
             "control": self.state[CONTROL].copy(),
         }

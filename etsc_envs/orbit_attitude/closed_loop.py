@@ -23,6 +23,7 @@ import numpy as np
 from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts, stored_features
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
+from etsc_envs.core.linalg import fused_dot
 from etsc_envs.core.rotations import se3_log
 from etsc_envs.orbit_attitude.controller import (
     ControllerGains,
@@ -157,10 +158,10 @@ def total_disturbance(
 @jit
 def tracking_cost(eta: np.ndarray, twist_error: np.ndarray, reference: np.ndarray) -> float:
     """Per-step accuracy cost ``¼ Σ_j log(1 + ‖x_j‖ / ref_j)`` for x = Φ, Δω, χ, Δv."""
-    cost = np.log1p(np.sqrt(eta[0:3] @ eta[0:3]) / reference[0])
-    cost += np.log1p(np.sqrt(twist_error[0:3] @ twist_error[0:3]) / reference[1])
-    cost += np.log1p(np.sqrt(eta[3:6] @ eta[3:6]) / reference[2])
-    cost += np.log1p(np.sqrt(twist_error[3:6] @ twist_error[3:6]) / reference[3])
+    cost = np.log1p(np.sqrt(fused_dot(eta[0:3], eta[0:3])) / reference[0])
+    cost += np.log1p(np.sqrt(fused_dot(twist_error[0:3], twist_error[0:3])) / reference[1])
+    cost += np.log1p(np.sqrt(fused_dot(eta[3:6], eta[3:6])) / reference[2])
+    cost += np.log1p(np.sqrt(fused_dot(twist_error[3:6], twist_error[3:6])) / reference[3])
     return 0.25 * cost
 
 
@@ -205,7 +206,7 @@ def closed_loop_step(
     dt = h / substeps
     for i in range(substeps):
         y_next = integrate_plant(t + i * dt, y_next, dt, (wrench, model))
-        y_next[0:4] /= np.sqrt(y_next[0:4] @ y_next[0:4])
+        y_next[0:4] /= np.sqrt(fused_dot(y_next[0:4], y_next[0:4]))
 
     # what the controller sees at t + h
     t_next = t + h
@@ -222,8 +223,8 @@ def closed_loop_step(
     cost = tracking_cost(eta, twist_error, cost_reference)
     e2_physical = inertia_times(e2, gains)
     diagnostics = np.empty(N_DIAGNOSTICS)
-    diagnostics[0] = np.sqrt(eta[0:3] @ eta[0:3])
-    diagnostics[1] = np.sqrt(eta[3:6] @ eta[3:6])
+    diagnostics[0] = np.sqrt(fused_dot(eta[0:3], eta[0:3]))
+    diagnostics[1] = np.sqrt(fused_dot(eta[3:6], eta[3:6]))
     diagnostics[2] = np.abs(eta[0:3]).max()
     diagnostics[3] = np.abs(twist_error[0:3]).max()
     diagnostics[4] = np.abs(eta[3:6]).max()
@@ -233,8 +234,8 @@ def closed_loop_step(
     diagnostics[8] = np.abs(e2_physical[0:3]).max()
     diagnostics[9] = np.abs(e2_physical[3:6]).max()
     diagnostics[10] = h * np.abs(output).sum()
-    diagnostics[11] = np.sqrt(twist_error[0:3] @ twist_error[0:3])
-    diagnostics[12] = np.sqrt(twist_error[3:6] @ twist_error[3:6])
+    diagnostics[11] = np.sqrt(fused_dot(twist_error[0:3], twist_error[0:3]))
+    diagnostics[12] = np.sqrt(fused_dot(twist_error[3:6], twist_error[3:6]))
     diagnostics[13] = 1.0 if np.isfinite(y_next).all() and np.isfinite(features).all() else 0.0
     return y_next, c_next, fresh, features, view_next, cost, diagnostics, output
 

@@ -22,6 +22,12 @@ from collections import namedtuple
 import numpy as np
 
 from etsc_envs.core.jit import jit
+from etsc_envs.core.linalg import (
+    fused_dot,
+    fused_matmul,
+    fused_matvec3,
+    fused_matvec3_transposed,
+)
 from etsc_envs.core.rotations import (
     cross,
     se3_ad,
@@ -82,8 +88,8 @@ def sig(x: np.ndarray, power: float) -> np.ndarray:
 def block_norms(x: np.ndarray) -> np.ndarray:
     """``[‖x[0:3]‖, ‖x[3:6]‖]``: the rotational and translational parts of a 6-vector."""
     out = np.empty(2)
-    out[0] = np.sqrt(x[0:3] @ x[0:3])
-    out[1] = np.sqrt(x[3:6] @ x[3:6])
+    out[0] = np.sqrt(fused_dot(x[0:3], x[0:3]))
+    out[1] = np.sqrt(fused_dot(x[3:6], x[3:6]))
     return out
 
 
@@ -100,7 +106,7 @@ def scale_blocks(x: np.ndarray, pair: np.ndarray) -> np.ndarray:
 def inertia_times(x: np.ndarray, gains: ControllerGains) -> np.ndarray:
     """``Ξ x = [J x_ω, m x_v]`` with the nominal Ξ."""
     out = np.empty(6)
-    out[0:3] = gains.inertia @ x[0:3]
+    out[0:3] = fused_matvec3(gains.inertia, x[0:3])
     out[3:6] = gains.mass * x[3:6]
     return out
 
@@ -109,7 +115,7 @@ def inertia_times(x: np.ndarray, gains: ControllerGains) -> np.ndarray:
 def inertia_solve(x: np.ndarray, gains: ControllerGains) -> np.ndarray:
     """``Ξ⁻¹ x`` with the nominal Ξ."""
     out = np.empty(6)
-    out[0:3] = gains.inertia_inv @ x[0:3]
+    out[0:3] = fused_matvec3(gains.inertia_inv, x[0:3])
     out[3:6] = x[3:6] / gains.mass
     return out
 
@@ -127,7 +133,7 @@ def known_dynamics(
     """
     leader = gains.leader
     g_d = leader_pose(t, leader)
-    g_a = g_d @ g_e
+    g_a = fused_matmul(g_d, g_e)
     rotation_a = np.ascontiguousarray(g_a[:3, :3])
     position = np.ascontiguousarray(g_a[:3, 3])
     desired = leader_twist(leader)
@@ -139,17 +145,19 @@ def known_dynamics(
     out = np.empty(6)
     # Ξ⁻¹ ad*_V Ξ V = [J⁻¹(-ω × Jω - v × m v), -ω × v]; v × m v = 0 is dropped exactly rather
     # than left to rounding (~1e-6 N·m at orbital speed).
-    out[0:3] = gains.inertia_inv @ (-cross(omega, gains.inertia @ omega))
+    out[0:3] = fused_matvec3(gains.inertia_inv, -cross(omega, fused_matvec3(gains.inertia, omega)))
     out[3:6] = -cross(omega, velocity)
     # + ad_Ṽ Ad_{g_e⁻¹} V_d  (V̇_d = 0 on the circular orbit)
     out += se3_ad(twist_error) @ desired_in_body
     # + Ξ⁻¹ f(Ξ): gravity-gradient moment and gravity force with J2, nominal J and m
-    position_body = rotation_a.T @ position
-    out[0:3] += gains.inertia_inv @ gravity_gradient_torque(position_body, gains.inertia, leader.mu)
+    position_body = fused_matvec3_transposed(rotation_a, position)
+    out[0:3] += fused_matvec3(
+        gains.inertia_inv, gravity_gradient_torque(position_body, gains.inertia, leader.mu)
+    )
     acceleration = kepler_gravity(position, leader.mu)
     if gains.j2 != 0.0:
         acceleration += j2_acceleration(position, leader.mu, gains.earth_radius, gains.j2)
-    out[3:6] += rotation_a.T @ acceleration
+    out[3:6] += fused_matvec3_transposed(rotation_a, acceleration)
     return out
 
 

@@ -35,6 +35,12 @@ from collections import namedtuple
 import numpy as np
 
 from etsc_envs.core.jit import jit
+from etsc_envs.core.linalg import (
+    fused_dot,
+    fused_matmul,
+    fused_matvec3,
+    fused_matvec3_transposed,
+)
 from etsc_envs.core.rotations import attitude_matrix, cross, quat_kinematics
 
 LeaderOrbit = namedtuple(
@@ -99,10 +105,9 @@ def leader_rotation(t: float, leader: LeaderOrbit) -> np.ndarray:
 
     ``R_d = R_z(Ω) R_x(i) R_z(u(t))`` with the argument of latitude ``u = u(0) + n t``.
     """
-    return (
-        _rotation_z(leader.raan)
-        @ _rotation_x(leader.inclination)
-        @ _rotation_z(leader.latitude_argument0 + leader.rate * t)
+    return fused_matmul(
+        fused_matmul(_rotation_z(leader.raan), _rotation_x(leader.inclination)),
+        _rotation_z(leader.latitude_argument0 + leader.rate * t),
     )
 
 
@@ -135,7 +140,7 @@ def leader_twist(leader: LeaderOrbit) -> np.ndarray:
 @jit
 def kepler_gravity(position: np.ndarray, mu: float) -> np.ndarray:
     """-μ r / ‖r‖³."""
-    r2 = position @ position
+    r2 = fused_dot(position, position)
     return -mu / (r2 * np.sqrt(r2)) * position
 
 
@@ -147,7 +152,7 @@ def kepler_gravity_difference(offset: np.ndarray, radius: float, mu: float) -> n
     ``1 - ‖r‖³/a³ = -expm1(1.5 log1p(s))``, ``s = (2 a ρ_x + ρ·ρ)/a²`` (Battin's device), so the
     result keeps full relative precision for any small ρ.
     """
-    s = (2.0 * radius * offset[0] + offset @ offset) / (radius * radius)
+    s = (2.0 * radius * offset[0] + fused_dot(offset, offset)) / (radius * radius)
     growth = 1.5 * math.log1p(s)
     one_minus_ratio = -math.expm1(growth)
     r3 = radius**3 * math.exp(growth)
@@ -159,7 +164,7 @@ def kepler_gravity_difference(offset: np.ndarray, radius: float, mu: float) -> n
 @jit
 def j2_acceleration(position: np.ndarray, mu: float, earth_radius: float, j2: float) -> np.ndarray:
     """``-(3 J2 μ r_e² / (2‖r‖⁵)) (E - 5 r_z²/‖r‖² I) r`` with ``E = diag(1, 1, 3)`` (ECI)."""
-    r2 = position @ position
+    r2 = fused_dot(position, position)
     factor = -1.5 * j2 * mu * earth_radius**2 / (r2 * r2 * np.sqrt(r2))
     z2 = position[2] * position[2] / r2
     out = np.empty(3)
@@ -172,8 +177,13 @@ def j2_acceleration(position: np.ndarray, mu: float, earth_radius: float, j2: fl
 @jit
 def gravity_gradient_torque(position_body: np.ndarray, inertia: np.ndarray, mu: float):
     """M_G = 3 μ/‖r‖⁵ (Rᵀr) × J (Rᵀr), with the position given in body components (Rᵀr)."""
-    r2 = position_body @ position_body
-    return 3.0 * mu / (r2 * r2 * np.sqrt(r2)) * cross(position_body, inertia @ position_body)
+    r2 = fused_dot(position_body, position_body)
+    return (
+        3.0
+        * mu
+        / (r2 * r2 * np.sqrt(r2))
+        * cross(position_body, fused_matvec3(inertia, position_body))
+    )
 
 
 # --------------------------------------------------------------------------- disturbances
@@ -226,41 +236,41 @@ def relative_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
     to_body = attitude_matrix(q)  # R_eᵀ
     leader_rate = np.zeros(3)
     leader_rate[2] = leader.rate
-    leader_rate_body = to_body @ leader_rate  # R_eᵀ ω_d
+    leader_rate_body = fused_matvec3(to_body, leader_rate)  # R_eᵀ ω_d
 
     # rotation: J ω̇ = -ω × Jω + M_G + τ + d_τ, then Δω̇ = ω̇ + Δω × R_eᵀω_d (ω̇_d = 0)
     omega = rate_error + leader_rate_body
     position_leader = offset.copy()
     position_leader[0] += leader.radius
-    position_body = to_body @ position_leader
+    position_body = fused_matvec3(to_body, position_leader)
     torque = (
         wrench[0:3]
         + gravity_gradient_torque(position_body, model.inertia, leader.mu)
         + disturbance_torque(t, model)
-        - cross(omega, model.inertia @ omega)
+        - cross(omega, fused_matvec3(model.inertia, omega))
     )
-    rate_error_dot = model.inertia_inv @ torque + cross(rate_error, leader_rate_body)
+    rate_error_dot = fused_matvec3(model.inertia_inv, torque) + cross(rate_error, leader_rate_body)
 
     # translation: Coriolis, centrifugal, differential gravity, forces
     gravity_leader = kepler_gravity_difference(offset, leader.radius, leader.mu)
     if model.j2 != 0.0:
         rotation_d = leader_rotation(t, leader)
-        position_eci = rotation_d @ position_leader
-        gravity_leader += rotation_d.T @ j2_acceleration(
-            position_eci, leader.mu, model.earth_radius, model.j2
+        position_eci = fused_matvec3(rotation_d, position_leader)
+        gravity_leader += fused_matvec3_transposed(
+            rotation_d, j2_acceleration(position_eci, leader.mu, model.earth_radius, model.j2)
         )
     centrifugal = -cross(leader_rate, cross(leader_rate, offset))
     force = wrench[3:6] + disturbance_force(t, model)
     velocity_error_dot = (
         -cross(rate_error, velocity_error)
         - 2.0 * cross(leader_rate_body, velocity_error)
-        + to_body @ (centrifugal + gravity_leader)
+        + fused_matvec3(to_body, centrifugal + gravity_leader)
         + force / model.mass
     )
 
     dy = np.empty(13)
     dy[0:4] = quat_kinematics(q, rate_error)
-    dy[4:7] = to_leader @ velocity_error
+    dy[4:7] = fused_matvec3(to_leader, velocity_error)
     dy[7:10] = rate_error_dot
     dy[10:13] = velocity_error_dot
     return dy

@@ -1,0 +1,155 @@
+"""3-vectors as tuples of three floats, for the allocation-free compiled hot path.
+
+Inside compiled code every NumPy expression on a small array allocates its result (about
+25 ns with the matching free), and a step of an RK4-integrated loop evaluates hundreds of
+them. A tuple of floats lives in registers instead. These helpers take any indexable
+3-vector (a tuple or a float64 array) and return tuples, so that equations read as they do
+with arrays: ``add(cross(omega, momentum), torque)``.
+
+Each helper performs the same floating-point operations, in the same order, as the array
+expression it replaces (products through :func:`etsc_envs.core.linalg.fused_multiply_add`
+where NumPy's ``@`` calls OpenBLAS), so rewriting an equation with them leaves its results
+unchanged to the last bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from etsc_envs.core.jit import jit
+from etsc_envs.core.linalg import fused_multiply_add
+
+Vec3 = tuple[float, float, float]
+"""A 3-vector as returned by the helpers of this module."""
+
+
+@jit
+def as_vec3(vector) -> Vec3:
+    """The first three entries of ``vector`` (an array or a tuple)."""
+    return (vector[0], vector[1], vector[2])
+
+
+@jit
+def to_array(vector) -> np.ndarray:
+    """A new float64 array holding the three entries of ``vector``."""
+    out = np.empty(3)
+    out[0] = vector[0]
+    out[1] = vector[1]
+    out[2] = vector[2]
+    return out
+
+
+@jit
+def store(out: np.ndarray, vector) -> None:
+    """Write the three entries of ``vector`` into ``out[0:3]``."""
+    out[0] = vector[0]
+    out[1] = vector[1]
+    out[2] = vector[2]
+
+
+@jit
+def add(a, b) -> Vec3:
+    """``a + b``."""
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@jit
+def subtract(a, b) -> Vec3:
+    """``a - b``."""
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@jit
+def negate(a) -> Vec3:
+    """``-a``."""
+    return (-a[0], -a[1], -a[2])
+
+
+@jit
+def scale(factor: float, a) -> Vec3:
+    """``factor * a`` for a scalar ``factor``."""
+    return (factor * a[0], factor * a[1], factor * a[2])
+
+
+@jit
+def multiply(a, b) -> Vec3:
+    """The elementwise product ``a * b``."""
+    return (a[0] * b[0], a[1] * b[1], a[2] * b[2])
+
+
+@jit
+def divide(a, b) -> Vec3:
+    """The elementwise quotient ``a / b``."""
+    return (a[0] / b[0], a[1] / b[1], a[2] / b[2])
+
+
+@jit
+def absolute_sum(a) -> float:
+    """``np.abs(a).sum()``, summed from zero in index order as NumPy's compiled ``sum`` does."""
+    return 0.0 + abs(a[0]) + abs(a[1]) + abs(a[2])
+
+
+@jit
+def sine_wave(amplitude, frequency, t: float, phase) -> Vec3:
+    """``amplitude * sin(frequency * t + phase)`` per component."""
+    return (
+        amplitude[0] * np.sin(frequency[0] * t + phase[0]),
+        amplitude[1] * np.sin(frequency[1] * t + phase[1]),
+        amplitude[2] * np.sin(frequency[2] * t + phase[2]),
+    )
+
+
+@jit
+def cross(a, b) -> Vec3:
+    """Vector product ``a × b``."""
+    return (
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    )
+
+
+@jit
+def dot(a, b) -> float:
+    """``a @ b`` as the chain ``fma(a_2, b_2, fma(a_1, b_1, a_0 b_0))`` (see
+    :func:`etsc_envs.core.linalg.fused_dot`)."""
+    return fused_multiply_add(a[2], b[2], fused_multiply_add(a[1], b[1], a[0] * b[0]))
+
+
+@jit
+def _matvec_row(matrix: np.ndarray, row: int, vector) -> float:
+    partial = fused_multiply_add(matrix[row, 0], vector[0], matrix[row, 1] * vector[1])
+    return fused_multiply_add(matrix[row, 2], vector[2], partial)
+
+
+@jit
+def matvec(matrix: np.ndarray, vector) -> Vec3:
+    """``matrix @ vector`` for a 3×3 array (see :func:`etsc_envs.core.linalg.fused_matvec3`)."""
+    return (
+        _matvec_row(matrix, 0, vector),
+        _matvec_row(matrix, 1, vector),
+        _matvec_row(matrix, 2, vector),
+    )
+
+
+@jit
+def solve(matrix: np.ndarray, rhs) -> Vec3:
+    """The solution x of the 3×3 system ``matrix · x = rhs``, by Cramer's rule: the adjugate
+    times ``rhs`` (rows as in :func:`matvec`), divided by the determinant."""
+    a = matrix
+    c00 = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
+    c01 = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
+    c02 = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
+    det = a[0, 0] * c00 + a[0, 1] * c01 + a[0, 2] * c02
+    c10 = a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]
+    c11 = a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]
+    c12 = a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]
+    c20 = a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]
+    c21 = a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]
+    c22 = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
+    r0, r1, r2 = rhs[0], rhs[1], rhs[2]
+    return (
+        fused_multiply_add(c20, r2, fused_multiply_add(c00, r0, c10 * r1)) / det,
+        fused_multiply_add(c21, r2, fused_multiply_add(c01, r0, c11 * r1)) / det,
+        fused_multiply_add(c22, r2, fused_multiply_add(c02, r0, c12 * r1)) / det,
+    )
