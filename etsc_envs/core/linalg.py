@@ -91,26 +91,41 @@ def fused_dot(left: np.ndarray, right: np.ndarray) -> float:
 
 
 @jit
-def fused_matvec3(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
-    """``matrix @ vector`` for a C-ordered 3×3 matrix, each row as ``fma(m_2 v_2, fma(m_0 v_0,
-    m_1 v_1))``: the same value, bit for bit, as the OpenBLAS ``dgemv`` NumPy's ``@`` calls,
-    without the call's overhead."""
+def fused_row_dot3(matrix: np.ndarray, row: int, vector) -> float:
+    """Entry ``row`` of ``matrix @ vector`` for a C-ordered 3×3 matrix, as ``fma(m_2 v_2,
+    fma(m_0 v_0, m_1 v_1))``: the value OpenBLAS's ``dgemv`` returns, bit for bit."""
+    partial = fused_multiply_add(matrix[row, 0], vector[0], matrix[row, 1] * vector[1])
+    return fused_multiply_add(matrix[row, 2], vector[2], partial)
+
+
+@jit
+def fused_column_dot3(matrix: np.ndarray, column: int, vector) -> float:
+    """Entry ``column`` of ``matrix.T @ vector`` for a C-ordered 3×3 matrix, as ``fma(m_2j v_2,
+    fma(m_1j v_1, m_0j v_0))``: the value OpenBLAS's ``dgemv`` returns on the transposed view,
+    bit for bit."""
+    partial = fused_multiply_add(matrix[1, column], vector[1], matrix[0, column] * vector[0])
+    return fused_multiply_add(matrix[2, column], vector[2], partial)
+
+
+@jit
+def fused_matvec3(matrix: np.ndarray, vector) -> np.ndarray:
+    """``matrix @ vector`` for a C-ordered 3×3 matrix by :func:`fused_row_dot3`: the same
+    value, bit for bit, as the OpenBLAS ``dgemv`` NumPy's ``@`` calls, without the call's
+    overhead."""
     out = np.empty(3)
     for i in range(3):
-        partial = fused_multiply_add(matrix[i, 0], vector[0], matrix[i, 1] * vector[1])
-        out[i] = fused_multiply_add(matrix[i, 2], vector[2], partial)
+        out[i] = fused_row_dot3(matrix, i, vector)
     return out
 
 
 @jit
-def fused_matvec3_transposed(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
-    """``matrix.T @ vector`` for a C-ordered 3×3 matrix, each entry as ``fma(m_2j v_2,
-    fma(m_1j v_1, m_0j v_0))``: the same value, bit for bit, as the OpenBLAS ``dgemv`` NumPy's
-    ``@`` calls on the transposed view, without the call's overhead."""
+def fused_matvec3_transposed(matrix: np.ndarray, vector) -> np.ndarray:
+    """``matrix.T @ vector`` for a C-ordered 3×3 matrix by :func:`fused_column_dot3`: the same
+    value, bit for bit, as the OpenBLAS ``dgemv`` NumPy's ``@`` calls on the transposed view,
+    without the call's overhead."""
     out = np.empty(3)
     for j in range(3):
-        partial = fused_multiply_add(matrix[1, j], vector[1], matrix[0, j] * vector[0])
-        out[j] = fused_multiply_add(matrix[2, j], vector[2], partial)
+        out[j] = fused_column_dot3(matrix, j, vector)
     return out
 
 

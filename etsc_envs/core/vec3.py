@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import fused_multiply_add
+from etsc_envs.core.linalg import fused_column_dot3, fused_multiply_add, fused_row_dot3
 
 Vec3 = tuple[float, float, float]
 """A 3-vector as returned by the helpers of this module."""
@@ -117,18 +117,24 @@ def dot(a, b) -> float:
 
 
 @jit
-def _matvec_row(matrix: np.ndarray, row: int, vector) -> float:
-    partial = fused_multiply_add(matrix[row, 0], vector[0], matrix[row, 1] * vector[1])
-    return fused_multiply_add(matrix[row, 2], vector[2], partial)
+def matvec(matrix: np.ndarray, vector) -> Vec3:
+    """``matrix @ vector`` for a C-ordered 3×3 array (see
+    :func:`etsc_envs.core.linalg.fused_row_dot3`)."""
+    return (
+        fused_row_dot3(matrix, 0, vector),
+        fused_row_dot3(matrix, 1, vector),
+        fused_row_dot3(matrix, 2, vector),
+    )
 
 
 @jit
-def matvec(matrix: np.ndarray, vector) -> Vec3:
-    """``matrix @ vector`` for a 3×3 array (see :func:`etsc_envs.core.linalg.fused_matvec3`)."""
+def matvec_transposed(matrix: np.ndarray, vector) -> Vec3:
+    """``matrix.T @ vector`` for a C-ordered 3×3 array (see
+    :func:`etsc_envs.core.linalg.fused_column_dot3`)."""
     return (
-        _matvec_row(matrix, 0, vector),
-        _matvec_row(matrix, 1, vector),
-        _matvec_row(matrix, 2, vector),
+        fused_column_dot3(matrix, 0, vector),
+        fused_column_dot3(matrix, 1, vector),
+        fused_column_dot3(matrix, 2, vector),
     )
 
 

@@ -32,6 +32,7 @@ from etsc_envs.orbit_attitude.controller import (
     control_law,
     eso_derivative,
     eso_input,
+    fixed_gain_feedback,
     inertia_solve,
     inertia_times,
     known_dynamics,
@@ -68,7 +69,8 @@ LEADER_LATITUDE = 111  # the leader's argument of latitude u(0), rad
 TORQUE_PHASE = slice(112, 115)  # phases of d_τ
 FORCE_PHASE = slice(115, 118)  # phases of d_f
 MISALIGNMENT = slice(118, 190)  # ΔD, 6×12 row-major
-STATE_WIDTH = 190
+TRUE_DISTRIBUTION = slice(190, 262)  # D + ΔD, 6×12 row-major (summed once per episode)
+STATE_WIDTH = 262
 """Layout of the state row."""
 
 INTEGRAL = slice(14, 16)
@@ -113,12 +115,9 @@ def controller_view(t: float, y: np.ndarray, c: np.ndarray, gains: ControllerGai
     drift = surface_drift(known, eta, twist_error, gains)
     z2 = c[6:12]
     phi_hat = c[12:14]
-    command = control_law(
-        drift, z2, surface, adaptive_gain(phi_hat, c[14:16], surface, t, gains), gains
-    )
-    fresh = control_law(
-        drift, z2, surface, adaptive_gain(phi_hat, np.zeros(2), surface, t, gains), gains
-    )
+    fixed_gain = fixed_gain_feedback(drift, z2, surface, gains)
+    command = control_law(fixed_gain, surface, adaptive_gain(phi_hat, c[14:16], surface, t, gains))
+    fresh = control_law(fixed_gain, surface, adaptive_gain(phi_hat, np.zeros(2), surface, t, gains))
     return eta, surface, drift, known, command, fresh
 
 
@@ -275,7 +274,7 @@ def episode_model(state: np.ndarray, constants: LoopConstants) -> PlantModel:
         shared.inertia,
         shared.inertia_inv,
         shared.mass,
-        shared.distribution + state[MISALIGNMENT].reshape(6, 12),
+        state[TRUE_DISTRIBUTION].reshape(6, 12),
         shared.allocation,
         shared.max_force,
         shared.bias_ratio,

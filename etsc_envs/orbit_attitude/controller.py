@@ -21,6 +21,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
 from etsc_envs.core.linalg import (
     fused_dot,
@@ -156,7 +157,9 @@ def known_dynamics(
     )
     acceleration = kepler_gravity(position, leader.mu)
     if gains.j2 != 0.0:
-        acceleration += j2_acceleration(position, leader.mu, gains.earth_radius, gains.j2)
+        acceleration = vec3.add(
+            acceleration, j2_acceleration(position, leader.mu, gains.earth_radius, gains.j2)
+        )
     out[3:6] += fused_matvec3_transposed(rotation_a, acceleration)
     return out
 
@@ -253,20 +256,22 @@ def adaptive_derivative(
 
 
 @jit
-def control_law(
-    drift: np.ndarray,
-    z2: np.ndarray,
-    surface: np.ndarray,
-    k3: np.ndarray,
-    gains: ControllerGains,
+def fixed_gain_feedback(
+    drift: np.ndarray, z2: np.ndarray, surface: np.ndarray, gains: ControllerGains
 ) -> np.ndarray:
-    """``Γ_cout = -Ξ(H1 + Ẑ2) - K1 sig^α(S) - (K2 + K3) S`` (eq. 22): [τ (N·m), u (N)]."""
+    """``-Ξ(H1 + Ẑ2) - K1 sig^α(S) - K2 S``: the part of eq. (22) without the adaptive K3."""
     return (
         -inertia_times(drift + z2, gains)
         - gains.gain_k1 * sig(surface, gains.alpha)
         - gains.gain_k2 * surface
-        - scale_blocks(surface, k3)
     )
+
+
+@jit
+def control_law(fixed_gain: np.ndarray, surface: np.ndarray, k3: np.ndarray) -> np.ndarray:
+    """``Γ_cout = -Ξ(H1 + Ẑ2) - K1 sig^α(S) - (K2 + K3) S`` (eq. 22): [τ (N·m), u (N)], from
+    :func:`fixed_gain_feedback` and the adaptive gains K3 = [K31, K32]."""
+    return fixed_gain - scale_blocks(surface, k3)
 
 
 @jit

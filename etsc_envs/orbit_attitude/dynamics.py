@@ -34,14 +34,12 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
 from etsc_envs.core.linalg import (
-    fused_dot,
     fused_matmul,
-    fused_matvec3,
-    fused_matvec3_transposed,
 )
-from etsc_envs.core.rotations import attitude_matrix, cross, quat_kinematics
+from etsc_envs.core.rotations import attitude_matrix, cross, quat_rate
 
 LeaderOrbit = namedtuple(
     "LeaderOrbit",
@@ -138,68 +136,73 @@ def leader_twist(leader: LeaderOrbit) -> np.ndarray:
 
 # --------------------------------------------------------------------------- gravity
 @jit
-def kepler_gravity(position: np.ndarray, mu: float) -> np.ndarray:
+def kepler_gravity(position, mu: float) -> vec3.Vec3:
     """-μ r / ‖r‖³."""
-    r2 = fused_dot(position, position)
-    return -mu / (r2 * np.sqrt(r2)) * position
+    r2 = vec3.dot(position, position)
+    return vec3.scale(-mu / (r2 * np.sqrt(r2)), position)
 
 
 @jit
-def kepler_gravity_difference(offset: np.ndarray, radius: float, mu: float) -> np.ndarray:
+def kepler_gravity_difference(offset, radius: float, mu: float) -> vec3.Vec3:
     """``g(a e_x + ρ) - g(a e_x)`` for ``g(r) = -μ r/‖r‖³``, without cancellation.
 
     With ``r = d + ρ`` and ``d = a e_x``: ``g(r) - g(d) = -μ/‖r‖³ [ρ + (1 - ‖r‖³/a³) d]`` and
     ``1 - ‖r‖³/a³ = -expm1(1.5 log1p(s))``, ``s = (2 a ρ_x + ρ·ρ)/a²`` (Battin's device), so the
     result keeps full relative precision for any small ρ.
     """
-    s = (2.0 * radius * offset[0] + fused_dot(offset, offset)) / (radius * radius)
+    s = (2.0 * radius * offset[0] + vec3.dot(offset, offset)) / (radius * radius)
     growth = 1.5 * math.log1p(s)
     one_minus_ratio = -math.expm1(growth)
     r3 = radius**3 * math.exp(growth)
-    out = -mu / r3 * offset
-    out[0] -= mu / r3 * one_minus_ratio * radius
-    return out
+    out = vec3.scale(-mu / r3, offset)
+    return (out[0] - mu / r3 * one_minus_ratio * radius, out[1], out[2])
 
 
 @jit
-def j2_acceleration(position: np.ndarray, mu: float, earth_radius: float, j2: float) -> np.ndarray:
+def j2_acceleration(position, mu: float, earth_radius: float, j2: float) -> vec3.Vec3:
     """``-(3 J2 μ r_e² / (2‖r‖⁵)) (E - 5 r_z²/‖r‖² I) r`` with ``E = diag(1, 1, 3)`` (ECI)."""
-    r2 = fused_dot(position, position)
+    r2 = vec3.dot(position, position)
     factor = -1.5 * j2 * mu * earth_radius**2 / (r2 * r2 * np.sqrt(r2))
     z2 = position[2] * position[2] / r2
-    out = np.empty(3)
-    out[0] = factor * (1.0 - 5.0 * z2) * position[0]
-    out[1] = factor * (1.0 - 5.0 * z2) * position[1]
-    out[2] = factor * (3.0 - 5.0 * z2) * position[2]
-    return out
+    return (
+        factor * (1.0 - 5.0 * z2) * position[0],
+        factor * (1.0 - 5.0 * z2) * position[1],
+        factor * (3.0 - 5.0 * z2) * position[2],
+    )
 
 
 @jit
-def gravity_gradient_torque(position_body: np.ndarray, inertia: np.ndarray, mu: float):
+def gravity_gradient_torque(position_body, inertia: np.ndarray, mu: float) -> vec3.Vec3:
     """M_G = 3 μ/‖r‖⁵ (Rᵀr) × J (Rᵀr), with the position given in body components (Rᵀr)."""
-    r2 = fused_dot(position_body, position_body)
-    return (
-        3.0
-        * mu
-        / (r2 * r2 * np.sqrt(r2))
-        * cross(position_body, fused_matvec3(inertia, position_body))
+    r2 = vec3.dot(position_body, position_body)
+    return vec3.scale(
+        3.0 * mu / (r2 * r2 * np.sqrt(r2)),
+        vec3.cross(position_body, vec3.matvec(inertia, position_body)),
     )
 
 
 # --------------------------------------------------------------------------- disturbances
 @jit
-def disturbance_torque(t: float, model: PlantModel) -> np.ndarray:
+def disturbance_torque(t: float, model: PlantModel) -> vec3.Vec3:
     """d_τ(t) of section IV, N·m (body frame)."""
-    return model.torque_offset + model.torque_amplitude * np.sin(
-        model.torque_frequency * t + model.torque_phase
+    return vec3.add(
+        model.torque_offset,
+        vec3.sine_wave(model.torque_amplitude, model.torque_frequency, t, model.torque_phase),
     )
 
 
 @jit
-def disturbance_force(t: float, model: PlantModel) -> np.ndarray:
+def disturbance_force(t: float, model: PlantModel) -> vec3.Vec3:
     """d_f(t) of section IV, N (body frame); its frequency is 2π‖ω_d‖."""
-    return model.force_offset + model.force_amplitude * np.sin(
-        model.force_frequency * t + model.force_phase
+    angle = model.force_frequency * t
+    amplitude, phase = model.force_amplitude, model.force_phase
+    return vec3.add(
+        model.force_offset,
+        (
+            amplitude[0] * np.sin(angle + phase[0]),
+            amplitude[1] * np.sin(angle + phase[1]),
+            amplitude[2] * np.sin(angle + phase[2]),
+        ),
     )
 
 
@@ -232,47 +235,58 @@ def relative_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
     offset = y[4:7]
     rate_error = y[7:10]
     velocity_error = y[10:13]
-    to_leader = np.ascontiguousarray(attitude_matrix(q).T)  # R_e
     to_body = attitude_matrix(q)  # R_eᵀ
-    leader_rate = np.zeros(3)
-    leader_rate[2] = leader.rate
-    leader_rate_body = fused_matvec3(to_body, leader_rate)  # R_eᵀ ω_d
+    leader_rate = (0.0, 0.0, leader.rate)
+    leader_rate_body = vec3.matvec(to_body, leader_rate)  # R_eᵀ ω_d
 
     # rotation: J ω̇ = -ω × Jω + M_G + τ + d_τ, then Δω̇ = ω̇ + Δω × R_eᵀω_d (ω̇_d = 0)
-    omega = rate_error + leader_rate_body
-    position_leader = offset.copy()
-    position_leader[0] += leader.radius
-    position_body = fused_matvec3(to_body, position_leader)
-    torque = (
-        wrench[0:3]
-        + gravity_gradient_torque(position_body, model.inertia, leader.mu)
-        + disturbance_torque(t, model)
-        - cross(omega, fused_matvec3(model.inertia, omega))
+    omega = vec3.add(rate_error, leader_rate_body)
+    position_leader = (offset[0] + leader.radius, offset[1], offset[2])
+    position_body = vec3.matvec(to_body, position_leader)
+    torque = vec3.subtract(
+        vec3.add(
+            vec3.add(wrench[0:3], gravity_gradient_torque(position_body, model.inertia, leader.mu)),
+            disturbance_torque(t, model),
+        ),
+        vec3.cross(omega, vec3.matvec(model.inertia, omega)),
     )
-    rate_error_dot = fused_matvec3(model.inertia_inv, torque) + cross(rate_error, leader_rate_body)
+    rate_error_dot = vec3.add(
+        vec3.matvec(model.inertia_inv, torque), vec3.cross(rate_error, leader_rate_body)
+    )
 
     # translation: Coriolis, centrifugal, differential gravity, forces
     gravity_leader = kepler_gravity_difference(offset, leader.radius, leader.mu)
     if model.j2 != 0.0:
         rotation_d = leader_rotation(t, leader)
-        position_eci = fused_matvec3(rotation_d, position_leader)
-        gravity_leader += fused_matvec3_transposed(
-            rotation_d, j2_acceleration(position_eci, leader.mu, model.earth_radius, model.j2)
+        position_eci = vec3.matvec(rotation_d, position_leader)
+        gravity_leader = vec3.add(
+            gravity_leader,
+            vec3.matvec_transposed(
+                rotation_d, j2_acceleration(position_eci, leader.mu, model.earth_radius, model.j2)
+            ),
         )
-    centrifugal = -cross(leader_rate, cross(leader_rate, offset))
-    force = wrench[3:6] + disturbance_force(t, model)
-    velocity_error_dot = (
-        -cross(rate_error, velocity_error)
-        - 2.0 * cross(leader_rate_body, velocity_error)
-        + fused_matvec3(to_body, centrifugal + gravity_leader)
-        + force / model.mass
+    centrifugal = vec3.negate(vec3.cross(leader_rate, vec3.cross(leader_rate, offset)))
+    force = vec3.add(wrench[3:6], disturbance_force(t, model))
+    velocity_error_dot = vec3.add(
+        vec3.add(
+            vec3.subtract(
+                vec3.negate(vec3.cross(rate_error, velocity_error)),
+                vec3.scale(2.0, vec3.cross(leader_rate_body, velocity_error)),
+            ),
+            vec3.matvec(to_body, vec3.add(centrifugal, gravity_leader)),
+        ),
+        vec3.divide(force, (model.mass, model.mass, model.mass)),
     )
 
+    attitude_rate = quat_rate(q, rate_error)
+    offset_rate = vec3.matvec(np.ascontiguousarray(to_body.T), velocity_error)  # R_e Δv
     dy = np.empty(13)
-    dy[0:4] = quat_kinematics(q, rate_error)
-    dy[4:7] = fused_matvec3(to_leader, velocity_error)
-    dy[7:10] = rate_error_dot
-    dy[10:13] = velocity_error_dot
+    for i in range(4):
+        dy[i] = attitude_rate[i]
+    for i in range(3):
+        dy[4 + i] = offset_rate[i]
+        dy[7 + i] = rate_error_dot[i]
+        dy[10 + i] = velocity_error_dot[i]
     return dy
 
 

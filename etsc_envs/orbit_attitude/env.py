@@ -40,6 +40,7 @@ from etsc_envs.orbit_attitude.closed_loop import (
     STEADY_MAX,
     THRUSTER_OUTPUT,
     TORQUE_PHASE,
+    TRUE_DISTRIBUTION,
     VELOCITY_DIVERGED,
     VIEW,
     LoopConstants,
@@ -322,7 +323,9 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         state[LEADER_LATITUDE] = math.radians(p.leader_latitude_argument_deg)
         state[TORQUE_PHASE] = p.torque_disturbance_phase
         state[FORCE_PHASE] = p.force_disturbance_phase
-        state[MISALIGNMENT] = self._draw_misalignment().ravel()
+        misalignment = self._draw_misalignment()
+        state[MISALIGNMENT] = misalignment.ravel()
+        state[TRUE_DISTRIBUTION] = (self.constants.model.distribution + misalignment).ravel()
         if self.randomize:
             axis = rng.normal(size=3)
             axis /= np.linalg.norm(axis)
