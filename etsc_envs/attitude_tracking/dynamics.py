@@ -13,7 +13,7 @@ import numpy as np
 
 from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.rotations import attitude_matrix, error_quaternion, quat_rate
+from etsc_envs.core.rotations import attitude_matrix, quat_error, quat_rate
 
 SINUSOID, SQUARE = 0, 1
 
@@ -113,9 +113,9 @@ def plant_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
 def tracking_error(t: float, y: np.ndarray, attitude_gain: np.ndarray, model: PlantModel):
     """Error quaternion q_e and rate ω_e = ω - C ω_d of eq. (4), and z = ω_e + K q_ev (eq. 8).
 
-    Returns ``(q_e, omega_e, z, C)``: arrays q_e and C, 3-tuples ω_e and z.
+    Returns ``(q_e, omega_e, z, C)``: the tuples q_e, ω_e and z and the array C.
     """
-    q_e = error_quaternion(y[0:4], y[7:11])
+    q_e = quat_error(y[0:4], y[7:11])
     dcm = attitude_matrix(q_e)
     omega_e = vec3.subtract(y[4:7], vec3.matvec(dcm, desired_rate(t, model)))
     z = vec3.add(omega_e, vec3.multiply(attitude_gain, q_e))

@@ -220,7 +220,7 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             "omega": plant[4:7].copy(),
             "q_d": plant[7:11].copy(),
             "omega_d": np.array(desired_rate(t, model)),
-            "q_e": q_e,
+            "q_e": np.array(q_e),
             "omega_e": np.array(omega_e),
             "x1": np.array(z),
             "x1_hat": state[OBSERVER][0:3].copy(),

@@ -53,10 +53,23 @@ def solve3(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 @jit
 def quat_multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Hamilton product ``p ⊗ q`` of scalar-last quaternions."""
+    return _quaternion_array(quat_product(p, q))
+
+
+@jit
+def _quaternion_array(q) -> np.ndarray:
     out = np.empty(4)
-    out[:3] = p[3] * q[:3] + q[3] * p[:3] + cross(p[:3], q[:3])
-    out[3] = p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2]
+    for i in range(4):
+        out[i] = q[i]
     return out
+
+
+@jit
+def quat_product(p, q) -> tuple[float, float, float, float]:
+    """Hamilton product ``p ⊗ q`` as a tuple (see :mod:`etsc_envs.core.vec3`); ``p`` and ``q``
+    may be arrays or tuples."""
+    vector = vec3.add(vec3.add(vec3.scale(p[3], q), vec3.scale(q[3], p)), vec3.cross(p, q))
+    return (vector[0], vector[1], vector[2], p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2])
 
 
 @jit
@@ -84,24 +97,28 @@ def quat_rate(q, omega) -> tuple[float, float, float, float]:
 @jit
 def quat_kinematics(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Quaternion rate ``q̇ = ½ q ⊗ [ω, 0]`` for the body-frame rate ω (eq. (1)/(2) of 002)."""
-    rate = quat_rate(q, omega)
-    out = np.empty(4)
-    for i in range(4):
-        out[i] = rate[i]
-    return out
+    return _quaternion_array(quat_rate(q, omega))
+
+
+@jit
+def quat_error(q, q_desired) -> tuple[float, float, float, float]:
+    """Attitude error ``q_e = q_d* ⊗ q`` (eq. (4) of 002) as a tuple: B relative to the desired
+    frame."""
+    conjugate = (-q_desired[0], -q_desired[1], -q_desired[2], q_desired[3])
+    return quat_product(conjugate, q)
 
 
 @jit
 def error_quaternion(q: np.ndarray, q_desired: np.ndarray) -> np.ndarray:
     """Attitude error ``q_e = q_d* ⊗ q`` (eq. (4) of 002): B relative to the desired frame."""
-    return quat_multiply(quat_conjugate(q_desired), q)
+    return _quaternion_array(quat_error(q, q_desired))
 
 
 @jit
 def attitude_matrix(q: np.ndarray) -> np.ndarray:
     """DCM ``(1 - 2 q_vᵀq_v) I + 2 q_v q_vᵀ - 2 q4 q_v^×`` mapping R-frame to B-frame components."""
     x, y, z = q[0], q[1], q[2]
-    diagonal = 1.0 - 2.0 * fused_dot(q[:3], q[:3])
+    diagonal = 1.0 - 2.0 * vec3.dot(q, q)
     twice_scalar = 2.0 * q[3]
     out = np.empty((3, 3))
     out[0, 0] = diagonal + 2.0 * (x * x)
