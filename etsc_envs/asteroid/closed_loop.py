@@ -40,10 +40,12 @@ from etsc_envs.asteroid.dynamics import (
 )
 from etsc_envs.asteroid.gravity import Polyhedron
 from etsc_envs.asteroid.gravity_grid import collides, grid_clearance
+from etsc_envs.core import vec3
 from etsc_envs.core.compiled_loop import ProblemKernels, stored_features
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
-from etsc_envs.core.rotations import error_quaternion
+from etsc_envs.core.linalg import fused_dot
+from etsc_envs.core.rotations import quat_error
 
 N_FEATURES = 14
 OK, NON_FINITE, LEFT_REGION, COLLISION, ATTITUDE_DIVERGED = 0, 1, 2, 3, 4
@@ -82,11 +84,11 @@ the cost and failure bounds."""
 def closed_loop_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
     """ẏ of the whole loop; ``args = (thrusting, gains, model)``."""
     thrusting, gains, model = args
-    thrust = thrust_law(y[R], gains) if thrusting else np.zeros(3)
-    s = sliding_vector(error_quaternion(y[Q], gains.desired_attitude), y[W], gains)
+    thrust = thrust_law(y[R], gains) if thrusting else (0.0, 0.0, 0.0)
+    s = sliding_vector(quat_error(y[Q], gains.desired_attitude), y[W], gains)
     dy = plant_derivative(t, y, thrust, attitude_law(s, y[B_HAT], gains), model)
     dy[B_HAT] = adaptive_law(s, y[B_HAT], gains)
-    dy[DELTA_V] = np.sqrt(thrust @ thrust) / model.mass
+    dy[DELTA_V] = np.sqrt(vec3.dot(thrust, thrust)) / model.mass
     return dy
 
 
@@ -106,12 +108,12 @@ def orbit_features(
 ) -> np.ndarray:
     """The observation's problem part at ``t`` (see ``env.FEATURE_NAMES``)."""
     r, v = y[R], y[V]
-    radius = np.sqrt(r @ r)
+    radius = np.sqrt(vec3.dot(r, r))
     features = np.empty(N_FEATURES)
     features[0] = radius
     features[1] = gains.reference_radius - radius
-    features[2] = (r @ v) / radius
-    features[3] = r @ v
+    features[2] = vec3.dot(r, v) / radius
+    features[3] = vec3.dot(r, v)
     features[4] = barrier_statistic(r, v, gains.reference_radius)
     features[5:8] = r
     features[8:11] = v
@@ -156,7 +158,7 @@ def closed_loop_step(
     for _ in range(n_substeps):
         thrusting = is_thrusting(t, burst_start, burst_duration)
         candidate = integrate(t, y, h, (thrusting, gains, model))
-        candidate[Q] /= np.sqrt(candidate[Q] @ candidate[Q])
+        candidate[Q] /= np.sqrt(fused_dot(candidate[Q], candidate[Q]))
         if not np.all(np.isfinite(candidate)):
             failure = NON_FINITE
             break
@@ -164,7 +166,7 @@ def closed_loop_step(
         t += h
         done += 1
         r = y[R]
-        radius = np.sqrt(r @ r)
+        radius = np.sqrt(vec3.dot(r, r))
         outside = max(0.0, radius - shell[1], shell[0] - radius)
         cost += outside * outside * h
         if outside > 0.0:
@@ -178,7 +180,7 @@ def closed_loop_step(
         if collides(r, model.grid, poly):
             failure = COLLISION
             break
-        if np.sqrt(y[W] @ y[W]) > max_rate:
+        if np.sqrt(vec3.dot(y[W], y[W])) > max_rate:
             failure = ATTITUDE_DIVERGED
             break
     features = orbit_features(t, y, burst_start, burst_duration, gains, model.grid)

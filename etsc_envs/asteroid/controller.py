@@ -12,6 +12,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
 
 LoopGains = namedtuple(
@@ -38,36 +39,41 @@ def barrier_statistic(r: np.ndarray, v: np.ndarray, reference_radius: float) -> 
 
     Eq. (15) triggers a burst when this plus α is <= 0: the spacecraft moves away from r_0.
     """
-    radius = np.sqrt(r @ r)
-    return (reference_radius - radius) * (r @ v) / radius
+    radius = np.sqrt(vec3.dot(r, r))
+    return (reference_radius - radius) * vec3.dot(r, v) / radius
 
 
 @jit
-def thrust_law(r: np.ndarray, gains: LoopGains) -> np.ndarray:
+def thrust_law(r: np.ndarray, gains: LoopGains) -> vec3.Vec3:
     """τ = K_1 sgn(e) e tanh(e / (r_0 - r_min)) r/‖r‖ with e = r_0 - ‖r‖ (eq. 16), replaced by
     F_M sgn(e) r/‖r‖ when ‖τ‖ >= F_M (eq. 17); N, in the asteroid frame."""
-    radius = np.sqrt(r @ r)
+    radius = np.sqrt(vec3.dot(r, r))
     error = gains.reference_radius - radius
-    unit = r / radius
+    unit = vec3.divide(r, (radius, radius, radius))
     magnitude = gains.thrust_gain * abs(error) * np.tanh(error / gains.shell_half_width)
     if abs(magnitude) >= gains.max_thrust:
-        return gains.max_thrust * np.sign(error) * unit
-    return magnitude * unit
+        return vec3.scale(gains.max_thrust * np.sign(error), unit)
+    return vec3.scale(magnitude, unit)
 
 
 @jit
-def sliding_vector(q_error: np.ndarray, omega: np.ndarray, gains: LoopGains) -> np.ndarray:
+def sliding_vector(q_error, omega, gains: LoopGains) -> vec3.Vec3:
     """s = ω + k_1 q_v (section 3.2), with q the attitude error and ω the body rate."""
-    return omega + gains.sliding_gain * q_error[:3]
+    return vec3.add(omega, vec3.scale(gains.sliding_gain, q_error))
 
 
 @jit
-def attitude_law(s: np.ndarray, b_hat: float, gains: LoopGains) -> np.ndarray:
+def attitude_law(s, b_hat: float, gains: LoopGains) -> vec3.Vec3:
     """u = -K_2 s - b̂ Tanh(ρ s) of eq. (18), N·m in the body frame."""
-    return -gains.attitude_gain * s - b_hat * np.tanh(gains.tanh_sharpness * s)
+    gain, sharpness = -gains.attitude_gain, gains.tanh_sharpness
+    return (
+        gain * s[0] - b_hat * np.tanh(sharpness * s[0]),
+        gain * s[1] - b_hat * np.tanh(sharpness * s[1]),
+        gain * s[2] - b_hat * np.tanh(sharpness * s[2]),
+    )
 
 
 @jit
-def adaptive_law(s: np.ndarray, b_hat: float, gains: LoopGains) -> float:
+def adaptive_law(s, b_hat: float, gains: LoopGains) -> float:
     """db̂/dt = c ‖s‖ - c_1 b̂ of eq. (19)."""
-    return gains.adaptive_rate * np.sqrt(s @ s) - gains.adaptive_leakage * b_hat
+    return gains.adaptive_rate * np.sqrt(vec3.dot(s, s)) - gains.adaptive_leakage * b_hat

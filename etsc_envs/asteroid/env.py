@@ -431,7 +431,7 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             "radius_m": np.array(np.linalg.norm(y[R])),
             "barrier_m2ps": np.array(barrier_statistic(y[R], y[V], gains.reference_radius)),
             "burst_active": np.array(float(thrusting)),
-            "thrust_n": thrust,
+            "thrust_n": np.array(thrust),
             "delta_v_mps": np.array(y[DELTA_V]),
             "q": y[Q].copy(),
             "q_error": q_error,
@@ -439,7 +439,7 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             "euler_error_deg": np.degrees(quat_to_euler321(q_error)),
             "omega_rad_s": y[W].copy(),
             "b_hat": np.array(y[B_HAT]),
-            "control_torque_nm": attitude_law(s, y[B_HAT], gains),
+            "control_torque_nm": np.array(attitude_law(s, y[B_HAT], gains)),
             "sun_direction_body": asteroid_to_body(t, y[Q], model.spin_rate)
             @ (inertial_to_asteroid(t, model.spin_rate) @ model.sun_inertial),
             "clearance_m": np.array(self.state[FEATURES][-1]),
