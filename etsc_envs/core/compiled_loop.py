@@ -146,64 +146,6 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
     features = kernels.features
 
     @closure_jit
-    def step_row(
-        i, actions, arrays, constants, h, n_steps, cost_scale, transmission_penalty, failure_cost
-    ):
-        step_index = arrays.step_index[i]
-        time_s = step_index * h
-        state = arrays.state[i]
-        held = arrays.held[i]
-        sent = arrays.sent[i]
-        n_channels = held.shape[0]
-        values = channel_values(state, constants, time_s)
-        sent_total = 0
-        for channel in range(n_channels):
-            sent[channel] = 0
-            if actions[i, channel] != 0 and accepts(state, held, constants, time_s, channel):
-                held[channel, :] = values[channel]
-                if arrays.transmissions[i, channel] > 0:
-                    interval = time_s - arrays.last_sent_s[i, channel]
-                    arrays.interevent_sum_s[i, channel] += interval
-                    if interval < arrays.interevent_min_s[i, channel]:
-                        arrays.interevent_min_s[i, channel] = interval
-                arrays.last_sent_s[i, channel] = time_s
-                arrays.transmissions[i, channel] += 1
-                sent[channel] = 1
-                sent_total += 1
-        costs = arrays.channel_costs[i]
-        advance(state, constants, step_index, h, held, sent, costs)
-        step_index += 1
-        arrays.step_index[i] = step_index
-        code = failure(state, constants)
-        arrays.failure_code[i] = code
-        cost = costs.sum()
-        failure_charge = 0.0
-        if code != 0:
-            if not np.isfinite(cost):
-                costs[:] = 0.0
-                cost = 0.0
-            failure_charge = failure_cost * (n_steps - step_index)
-        else:
-            observation = arrays.observation[i]
-            n_features = observation.shape[0] - n_channels
-            scratch = np.empty(n_features)
-            features(state, constants, scratch)
-            observation[:n_features] = scratch
-            time_next = step_index * h
-            for channel in range(n_channels):
-                observation[n_features + channel] = time_next - arrays.last_sent_s[i, channel]
-        arrays.cost[i] = cost
-        arrays.sent_count[i] = sent_total
-        arrays.transmission_count[i] += sent_total
-        arrays.cost_sum[i] += cost
-        arrays.reward[i] = -(cost + failure_charge) / cost_scale - transmission_penalty * sent_total
-        share = failure_charge / n_channels
-        for channel in range(n_channels):
-            arrays.channel_rewards[i, channel] = (
-                -(costs[channel] + share) / cost_scale - transmission_penalty * sent[channel]
-            )
-
-    @closure_jit
     def loop_step(
         actions,
         active,
@@ -215,18 +157,76 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
         transmission_penalty,
         failure_cost,
     ):
+        # One loop over the rows with the batch's arrays bound once: a per-row call taking the
+        # namedtuple of arrays cost 0.5 µs a row in argument copies and reference counts.
+        step_indices = arrays.step_index
+        states = arrays.state
+        helds = arrays.held
+        sents = arrays.sent
+        transmissions = arrays.transmissions
+        last_sent_s = arrays.last_sent_s
+        interevent_sum_s = arrays.interevent_sum_s
+        interevent_min_s = arrays.interevent_min_s
+        channel_costs = arrays.channel_costs
+        channel_rewards = arrays.channel_rewards
+        observations = arrays.observation
+        n_channels = helds.shape[1]
+        n_features = observations.shape[1] - n_channels
+        scratch = np.empty(n_features)
         for i in range(actions.shape[0]):
-            if active[i]:
-                step_row(
-                    i,
-                    actions,
-                    arrays,
-                    constants,
-                    h,
-                    n_steps,
-                    cost_scale,
-                    transmission_penalty,
-                    failure_cost,
+            if not active[i]:
+                continue
+            step_index = step_indices[i]
+            time_s = step_index * h
+            state = states[i]
+            held = helds[i]
+            sent = sents[i]
+            values = channel_values(state, constants, time_s)
+            sent_total = 0
+            for channel in range(n_channels):
+                sent[channel] = 0
+                if actions[i, channel] != 0 and accepts(state, held, constants, time_s, channel):
+                    held[channel, :] = values[channel]
+                    if transmissions[i, channel] > 0:
+                        interval = time_s - last_sent_s[i, channel]
+                        interevent_sum_s[i, channel] += interval
+                        if interval < interevent_min_s[i, channel]:
+                            interevent_min_s[i, channel] = interval
+                    last_sent_s[i, channel] = time_s
+                    transmissions[i, channel] += 1
+                    sent[channel] = 1
+                    sent_total += 1
+            costs = channel_costs[i]
+            advance(state, constants, step_index, h, held, sent, costs)
+            step_index += 1
+            step_indices[i] = step_index
+            code = failure(state, constants)
+            arrays.failure_code[i] = code
+            cost = costs.sum()
+            failure_charge = 0.0
+            if code != 0:
+                if not np.isfinite(cost):
+                    costs[:] = 0.0
+                    cost = 0.0
+                failure_charge = failure_cost * (n_steps - step_index)
+            else:
+                observation = observations[i]
+                features(state, constants, scratch)
+                observation[:n_features] = scratch
+                time_next = step_index * h
+                for channel in range(n_channels):
+                    observation[n_features + channel] = time_next - last_sent_s[i, channel]
+            arrays.cost[i] = cost
+            arrays.sent_count[i] = sent_total
+            arrays.transmission_count[i] += sent_total
+            arrays.cost_sum[i] += cost
+            arrays.reward[i] = (
+                -(cost + failure_charge) / cost_scale - transmission_penalty * sent_total
+            )
+            share = failure_charge / n_channels
+            for channel in range(n_channels):
+                channel_rewards[i, channel] = (
+                    -(costs[channel] + share) / cost_scale - transmission_penalty * sent[channel]
                 )
 
     return loop_step
