@@ -22,7 +22,6 @@ from etsc_envs.attitude_tracking.controller import (
 )
 from etsc_envs.attitude_tracking.dynamics import (
     PlantModel,
-    desired_rate,
     plant_derivative,
     tracking_error,
 )
@@ -74,9 +73,10 @@ def write_sensor_features(features: np.ndarray, z, x_hat: np.ndarray, xi, gains:
 
 
 @jit
-def tracking_accuracy(t: float, y: np.ndarray, model: PlantModel):
-    """Integrands of eq. (50): (1/3) Σ|ω_i - ω_di| and (1/4) Σ|q_i - q_di|."""
-    rate_error = vec3.absolute_sum(vec3.subtract(y[4:7], desired_rate(t, model))) / 3.0
+def tracking_accuracy(y: np.ndarray, omega_d):
+    """Integrands of eq. (50): (1/3) Σ|ω_i - ω_di| and (1/4) Σ|q_i - q_di|, for the desired
+    rate ``omega_d`` at the instant of ``y``."""
+    rate_error = vec3.absolute_sum(vec3.subtract(y[4:7], omega_d)) / 3.0
     attitude_error = 0.0
     for i in range(4):
         attitude_error += abs(y[i] - y[7 + i])
@@ -116,12 +116,12 @@ def closed_loop_step(
     energy_increment = kinetic_energy_change(y_next, y)
     y[:] = y_next
     t_next = t + h
-    _, omega_e, z, _ = tracking_error(t_next, y, gains.attitude_gain, model)
+    _, omega_e, z, _, omega_d = tracking_error(t_next, y, gains.attitude_gain, model)
     vec3.store(state[TORQUE], torque)
     vec3.store(state[MEASUREMENT], z)
     vec3.store(state[RATE_ERROR], omega_e)
     write_sensor_features(state[FEATURES], z, x_hat, xi, gains)
-    rate_error, attitude_error = tracking_accuracy(t_next, y, model)
+    rate_error, attitude_error = tracking_accuracy(y, omega_d)
     return rate_error, attitude_error, energy_increment
 
 

@@ -113,13 +113,15 @@ def plant_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
 def tracking_error(t: float, y: np.ndarray, attitude_gain: np.ndarray, model: PlantModel):
     """Error quaternion q_e and rate ω_e = ω - C ω_d of eq. (4), and z = ω_e + K q_ev (eq. 8).
 
-    Returns ``(q_e, omega_e, z, C)``: the tuples q_e, ω_e and z and the array C.
+    Returns ``(q_e, omega_e, z, C, omega_d)``: the tuples q_e, ω_e and z, the array C, and the
+    desired rate ω_d(t) they were computed with.
     """
     q_e = quat_error(y[0:4], y[7:11])
     dcm = attitude_matrix(q_e)
-    omega_e = vec3.subtract(y[4:7], vec3.matvec(dcm, desired_rate(t, model)))
+    omega_d = desired_rate(t, model)
+    omega_e = vec3.subtract(y[4:7], vec3.matvec(dcm, omega_d))
     z = vec3.add(omega_e, vec3.multiply(attitude_gain, q_e))
-    return q_e, omega_e, z, dcm
+    return q_e, omega_e, z, dcm, omega_d
 
 
 @jit
@@ -130,8 +132,7 @@ def total_disturbance(
 
     Computed from the true plant: ż = ω̇ + ω_e^× C ω_d - C ω̇_d + ½ K (q_e4 I + q_ev^×) ω_e.
     """
-    q_e, omega_e, _, dcm = tracking_error(t, y, attitude_gain, model)
-    omega_d = desired_rate(t, model)
+    q_e, omega_e, _, dcm, omega_d = tracking_error(t, y, attitude_gain, model)
     z_dot = vec3.add(
         vec3.subtract(
             vec3.add(

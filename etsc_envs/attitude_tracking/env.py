@@ -34,7 +34,6 @@ from etsc_envs.attitude_tracking.dynamics import (
     SINUSOID,
     SQUARE,
     PlantModel,
-    desired_rate,
     total_disturbance,
     tracking_error,
 )
@@ -169,7 +168,7 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             rate = np.array(p.initial_rate, dtype=float)
         desired = np.array(p.initial_desired_attitude) / np.linalg.norm(p.initial_desired_attitude)
         state[PLANT] = np.concatenate([attitude, rate, desired])
-        _, state[RATE_ERROR], state[MEASUREMENT], _ = tracking_error(
+        _, state[RATE_ERROR], state[MEASUREMENT], _, _ = tracking_error(
             0.0, state[PLANT], self.gains.attitude_gain, self.model
         )
         if p.observer_start == "first_measurement":
@@ -212,14 +211,14 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
         state = self.state
         model = self.model
         plant = state[PLANT]
-        q_e, omega_e, z, _ = tracking_error(t, plant, self.gains.attitude_gain, model)
+        q_e, omega_e, z, _, omega_d = tracking_error(t, plant, self.gains.attitude_gain, model)
         torque = state[TORQUE].copy()
         return {
             "time_s": np.array(t),
             "q": plant[0:4].copy(),
             "omega": plant[4:7].copy(),
             "q_d": plant[7:11].copy(),
-            "omega_d": np.array(desired_rate(t, model)),
+            "omega_d": np.array(omega_d),
             "q_e": np.array(q_e),
             "omega_e": np.array(omega_e),
             "x1": np.array(z),

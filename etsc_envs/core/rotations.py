@@ -73,11 +73,14 @@ def quat_product(p, q) -> tuple[float, float, float, float]:
 
 
 @jit
+def _conjugate(q) -> tuple[float, float, float, float]:
+    return (-q[0], -q[1], -q[2], q[3])
+
+
+@jit
 def quat_conjugate(q: np.ndarray) -> np.ndarray:
     """Conjugate ``[-q_v, q4]``, the inverse of a unit quaternion."""
-    out = -q.copy()
-    out[3] = q[3]
-    return out
+    return _quaternion_array(_conjugate(q))
 
 
 @jit
@@ -104,8 +107,7 @@ def quat_kinematics(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
 def quat_error(q, q_desired) -> tuple[float, float, float, float]:
     """Attitude error ``q_e = q_d* ⊗ q`` (eq. (4) of 002) as a tuple: B relative to the desired
     frame."""
-    conjugate = (-q_desired[0], -q_desired[1], -q_desired[2], q_desired[3])
-    return quat_product(conjugate, q)
+    return quat_product(_conjugate(q_desired), q)
 
 
 @jit

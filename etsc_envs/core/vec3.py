@@ -30,21 +30,19 @@ def as_vec3(vector) -> Vec3:
 
 
 @jit
-def to_array(vector) -> np.ndarray:
-    """A new float64 array holding the three entries of ``vector``."""
-    out = np.empty(3)
-    out[0] = vector[0]
-    out[1] = vector[1]
-    out[2] = vector[2]
-    return out
-
-
-@jit
 def store(out: np.ndarray, vector) -> None:
     """Write the three entries of ``vector`` into ``out[0:3]``."""
     out[0] = vector[0]
     out[1] = vector[1]
     out[2] = vector[2]
+
+
+@jit
+def to_array(vector) -> np.ndarray:
+    """A new float64 array holding the three entries of ``vector``."""
+    out = np.empty(3)
+    store(out, vector)
+    return out
 
 
 @jit

@@ -36,9 +36,7 @@ import numpy as np
 
 from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import (
-    fused_matmul,
-)
+from etsc_envs.core.linalg import fused_matmul
 from etsc_envs.core.rotations import attitude_matrix, cross, quat_rate
 
 LeaderOrbit = namedtuple(
@@ -279,7 +277,9 @@ def relative_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
     )
 
     attitude_rate = quat_rate(q, rate_error)
-    offset_rate = vec3.matvec(np.ascontiguousarray(to_body.T), velocity_error)  # R_e Δv
+    # R_e Δv with the row kernel on a transposed copy: vec3.matvec_transposed sums in another
+    # order (dgemv's on a transposed view) and would change the last bits
+    offset_rate = vec3.matvec(np.ascontiguousarray(to_body.T), velocity_error)
     dy = np.empty(13)
     for i in range(4):
         dy[i] = attitude_rate[i]
