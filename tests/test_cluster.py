@@ -279,8 +279,10 @@ def test_unreachable_follower_is_rejected():
 def test_figure_2_substitute_has_the_documented_structure():
     adjacency = ClusterContainmentParams().adjacency
     weights = containment_weights(adjacency, N_PAPER)
-    assert adjacency[2, 6:].sum() == 0.0  # follower 3 hears no leader directly
-    assert np.all(weights[4:6] > 0.0)  # followers 5 and 6 are reached by all three leaders
+    follower_block, leader_block = adjacency[:N_PAPER, :N_PAPER], adjacency[:N_PAPER, N_PAPER:]
+    assert np.all(leader_block.sum(axis=1) == 1.0)  # every follower hears one leader
+    assert np.all(follower_block.sum(axis=1) == 1.0)  # ... and one follower
+    assert np.all(weights > 0.0)  # every follower is reached by all three leaders
     assert all(0 in reachable_from(adjacency, i) for i in (0, 1, 2, 3))  # cycle 1→4→3→2→1
     assert len(FIGURE_2_EDGES) == int(adjacency.sum())
 
@@ -297,8 +299,11 @@ def test_figure_5_substitute_has_the_cells_of_section_5_2():
     for cell in FIGURE_5_CELLS:
         followers = [i for i in cell if i < params.n_followers]
         assert_allclose(targets[followers], targets[followers[:1]].repeat(len(followers), 0))
-    assert_allclose(targets[2:6], np.tile(params.leader_attitudes[2], (4, 1)), atol=1e-14)
-    assert np.linalg.norm(targets[0] - targets[8]) > 0.05  # three distinct azimuths
+    leaders = params.leader_attitudes
+    assert_allclose(targets[0], leaders[0] / 2 + leaders[1] / 4 + leaders[2] / 4, atol=1e-14)
+    assert_allclose(targets[2:6], np.tile(leaders.mean(axis=0), (4, 1)), atol=1e-14)
+    assert_allclose(targets[8], (leaders[1] + leaders[2]) / 2, atol=1e-14)
+    assert np.all(params.adjacency[2:4, 9:] == 1.0)  # 3 and 4 hear all three leaders
 
 
 # --------------------------------------------------------------------------- physics

@@ -86,31 +86,34 @@ EXTRA_CONSTANT_DISTURBANCES = (
 FIGURE_2_EDGES = (
     (1, 7), (1, 2),
     (2, 9), (2, 3),
-    (3, 4),
+    (3, 8), (3, 4),
     (4, 9), (4, 1),
-    (5, 1), (5, 8),
-    (6, 5), (6, 8),
+    (5, 8), (5, 1),
+    (6, 8), (6, 5),
 )  # fmt: skip
 """Substitute for Figure 2 (lost): ``(receiver, sender)`` in the paper's 1-based numbering.
 
-Leader 7 feeds follower 1, leader 9 feeds 2 and 4, leader 8 feeds 5 and 6; followers 1→4→3→2→1
-form a directed cycle and 5, 6 relay from 1 and 5. Every follower is reached (Assumption 3),
-3 hears no leader directly, and 5 and 6 are reached by all three leaders (interior targets).
+Every follower hears one leader and one follower: leader 7 feeds follower 1, leader 9 feeds 2
+and 4, leader 8 feeds 3, 5 and 6; followers 1→4→3→2→1 form a directed cycle and 5, 6 relay
+from 1 and 5. Every follower is reached by all three leaders, so every target lies inside the
+leaders' triangle (docs/fidelity.md, paper 001, reading 1).
 """
 
 FIGURE_5_EDGES = (
     (9, 11), (9, 12),
     (1, 10), (1, 9), (2, 10), (2, 9), (2, 1),
     (7, 10), (7, 9), (8, 10), (8, 9), (8, 7),
-    (3, 12), (3, 4), (4, 12),
+    (3, 10), (3, 11), (3, 12), (3, 4), (4, 10), (4, 11), (4, 12),
     (5, 3), (6, 4), (6, 5),
 )  # fmt: skip
 """Substitute for Figure 5 (lost), 1-based ``(receiver, sender)``, 9 followers, leaders 10-12.
 
 π1 cells (Definition 2): {10}, {11}, {12}, {1, 2, 7, 8}, {3, 4}, {5, 6}, {9}. Each of 1, 2, 7,
 8 hears one member of {10} and one of {9} (plus links inside the cell, which Theorem 4 leaves
-free); each of 3, 4 hears leader 12; each of 5, 6 hears one of {3, 4} and nothing outside, so
-3, 4, 5, 6 share one steady state (section 5.2); 9 hears leaders 11 and 12.
+free); each of 3, 4 hears all three leaders; each of 5, 6 hears one of {3, 4} and nothing
+outside, so 3, 4, 5, 6 share one steady state (section 5.2: "C5 only receive information from
+C3"); 9 hears leaders 11 and 12. Steady states: σ10/2 + σ11/4 + σ12/4, the leaders' centroid,
+(σ11 + σ12)/2 (docs/fidelity.md, paper 001, reading 2).
 """
 FIGURE_5_CELLS = ((9,), (10,), (11,), (0, 1, 6, 7), (2, 3), (4, 5), (8,))
 """The π1 partition of :data:`FIGURE_5_EDGES`, 0-based node indices."""
