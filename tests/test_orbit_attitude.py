@@ -461,6 +461,40 @@ def test_total_disturbance_is_the_surface_rate_not_explained_by_the_model():
     assert_allclose(state["total_disturbance"], expected, rtol=1e-4, atol=1e-8)
 
 
+def test_disturbance_step_is_the_jump_of_the_total_disturbance_at_a_transmission():
+    """Changing only the held command moves Δd by Ξ⁻¹ ``disturbance_step``, in the saturated
+    and in the unsaturated regime; with the nominal model the step is zero."""
+    from etsc_envs.orbit_attitude.closed_loop import disturbance_step, total_disturbance
+
+    small_before = np.full(6, 1e-3)
+    small_after = np.array([2e-3, -1e-3, 0.0, 3e-3, 0.0, -2e-3])
+    for kwargs in ({}, NOMINAL):
+        env = make(horizon_s=1.0, **kwargs)
+        unwrapped = env.unwrapped
+        env.reset(seed=0)
+        env.step(1)
+        held = unwrapped.state_dict()["held_command"]  # ~25 N: saturated thrusters
+        model, gains = unwrapped.model, unwrapped.gains
+        t, y = unwrapped.time_s, unwrapped.plant_state
+
+        def disturbance(command, model=model, gains=gains, t=t, y=y):
+            wrench = thruster_outputs(command, model)[2]
+            return total_disturbance(t, y, wrench, command, np.zeros(6), model, gains)
+
+        for before, after in ((held, 0.5 * held), (small_before, small_after)):
+            jump = disturbance(after) - disturbance(before)
+            step = disturbance_step(before, after, model, gains)
+            expected = np.concatenate([gains.inertia @ jump[0:3], gains.mass * jump[3:6]])
+            assert_allclose(step, expected, rtol=1e-9, atol=1e-15)
+            if kwargs is NOMINAL:
+                assert_allclose(step, 0.0, atol=1e-15)
+        if kwargs is not NOMINAL:
+            # unsaturated, ΔJ = 0.1 J dominates: torque step ≈ (1/1.1 - 1) of the command step
+            step = disturbance_step(small_before, small_after, model, gains)
+            ratio = np.abs(step[0:3]).max() / np.abs(small_after - small_before)[0:3].max()
+            assert 0.05 < ratio < 0.2
+
+
 # --------------------------------------------------------------------------- closed loop
 def test_always_transmitting_converges_inside_the_papers_bounds():
     """The paper's P1 with the controller at 10 ms (for test time) and ``always``."""

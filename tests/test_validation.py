@@ -23,7 +23,10 @@ from etsc_envs.core.validation import (
 BAD_NUMBERS = [np.nan, np.inf, -np.inf]
 
 
-@pytest.mark.parametrize("value", [0.0, -1.0, -1e-300, *BAD_NUMBERS])
+NOT_NUMBERS = ["0.001", b"1", True, None, [1.0]]
+
+
+@pytest.mark.parametrize("value", [0.0, -1.0, -1e-300, *BAD_NUMBERS, *NOT_NUMBERS])
 def test_require_positive_rejects(value):
     with pytest.raises(ValueError, match="sample_time_s"):
         require_positive("sample_time_s", value)
@@ -36,7 +39,7 @@ def test_require_positive_accepts(value):
     assert result == float(value)
 
 
-@pytest.mark.parametrize("value", [-1.0, -1e-300, *BAD_NUMBERS])
+@pytest.mark.parametrize("value", [-1.0, -1e-300, *BAD_NUMBERS, *NOT_NUMBERS])
 def test_require_non_negative_rejects(value):
     with pytest.raises(ValueError, match="threshold"):
         require_non_negative("threshold", value)

@@ -3,23 +3,33 @@
 from __future__ import annotations
 
 import dataclasses
+import numbers
 from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
 
 
+def _real_number(name: str, value: float, allowed: str) -> float:
+    """``value`` as a float, or ``ValueError`` if it is not a real number (a string, say)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(
+            f"{name} must be a finite number {allowed}, got {value!r} ({type(value).__name__})"
+        )
+    return float(value)
+
+
 def require_positive(name: str, value: float) -> float:
-    """``value`` as a float, or ``ValueError`` unless it is finite and > 0."""
-    value = float(value)
+    """``value`` as a float, or ``ValueError`` unless it is a finite real number > 0."""
+    value = _real_number(name, value, "> 0")
     if not np.isfinite(value) or value <= 0.0:
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
     return value
 
 
 def require_non_negative(name: str, value: float) -> float:
-    """``value`` as a float, or ``ValueError`` unless it is finite and >= 0."""
-    value = float(value)
+    """``value`` as a float, or ``ValueError`` unless it is a finite real number >= 0."""
+    value = _real_number(name, value, ">= 0")
     if not np.isfinite(value) or value < 0.0:
         raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     return value

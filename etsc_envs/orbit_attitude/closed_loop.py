@@ -155,6 +155,25 @@ def total_disturbance(
 
 
 @jit
+def disturbance_step(
+    before: np.ndarray, after: np.ndarray, model: PlantModel, gains: ControllerGains
+) -> np.ndarray:
+    """Ξ times the jump of Δd when the held command steps from ``before`` to ``after``.
+
+    Δd of section II-C holds Ξ1⁻¹Γ_actual − Ξ⁻¹Γ_c (ΔΞ̃, ΔD and the bias acting on the
+    command), the one part of it that jumps at a transmission; everything else in Δd moves
+    continuously with the state. The ESO sees a jump only through its effect on S afterwards,
+    so at that transmission |e2| grows by the jump whatever the observer. Returned as [N·m, N].
+    """
+    wrench_step = thruster_outputs(after, model)[2] - thruster_outputs(before, model)[2]
+    true_step = np.empty(6)
+    true_step[0:3] = model.inertia_inv @ wrench_step[0:3]
+    true_step[3:6] = wrench_step[3:6] / model.mass
+    fed_step = inertia_solve(eso_input(after, gains) - eso_input(before, gains), gains)
+    return inertia_times(true_step - fed_step, gains)
+
+
+@jit
 def tracking_cost(eta: np.ndarray, twist_error: np.ndarray, reference: np.ndarray) -> float:
     """Per-step accuracy cost ``¼ Σ_j log(1 + ‖x_j‖ / ref_j)`` for x = Φ, Δω, χ, Δv."""
     cost = np.log1p(np.sqrt(fused_dot(eta[0:3], eta[0:3])) / reference[0])
