@@ -62,8 +62,9 @@ OBSERVER_TIMES = {  # "Ẑ1 tracks S in 10 s ... Δd is reconstructed by Ẑ2 wi
     REF19: {"e1_converged_s": None, "e2_converged_s": None},  # "slightly longer"
 }
 DISTURBANCE_STEP_KEYS = ("dd_step_rot_Nm", "dd_step_trans_N")
-"""Largest |Ξ·(jump of Δd)| at a transmission in the steady window: no observer can track a
-step it has not seen, so the steady max of |e2| cannot fall below it (docs/fidelity.md)."""
+"""Largest |Ξ·(jump of Δd)| at a transmission in the steady window: no observer tracks a step
+before it sees it, so the steady max of |e2| is of this size whatever the observer
+(docs/fidelity.md)."""
 COMMUNICATION_KEYS = (
     "transmissions",
     "transmissions_quiet_window",

@@ -163,7 +163,7 @@ def disturbance_step(
     Δd of section II-C holds Ξ1⁻¹Γ_actual − Ξ⁻¹Γ_c (ΔΞ̃, ΔD and the bias acting on the
     command), the one part of it that jumps at a transmission; everything else in Δd moves
     continuously with the state. The ESO sees a jump only through its effect on S afterwards,
-    so at that transmission |e2| grows by the jump whatever the observer. Returned as [N·m, N].
+    so at that transmission e2 changes by the jump whatever the observer. Returned as [N·m, N].
     """
     wrench_step = thruster_outputs(after, model)[2] - thruster_outputs(before, model)[2]
     true_step = np.empty(6)
