@@ -314,3 +314,45 @@ def test_a_new_process_loads_the_loop_step_from_the_disk_cache(tmp_path):
         for _ in range(2)
     ]
     assert hits == ["0", "1"], "compiled in the first process, loaded in the second"
+
+
+def test_editing_a_callee_module_invalidates_its_callers_cache(tmp_path):
+    """Numba invalidates a cached function only when its own file changes; a caller in another
+    file carries the callee's code, so without the package stamp of ``core.jit`` it would keep
+    computing with the callee's old body after an edit (plain ``njit(cache=True)`` prints 2.0
+    in the third process below)."""
+    if os.environ.get("NUMBA_DISABLE_JIT") == "1":
+        pytest.skip("nothing is compiled under NUMBA_DISABLE_JIT=1")
+    package = tmp_path / "packages" / "stampcheck"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    callee = package / "callee.py"
+    callee.write_text("from etsc_envs.core.jit import jit\n\n@jit\ndef value():\n    return 1.0\n")
+    (package / "caller.py").write_text(
+        "from etsc_envs.core.jit import jit\nfrom stampcheck.callee import value\n\n"
+        "@jit\ndef total():\n    return value() + 1.0\n"
+    )
+    script = (
+        "from stampcheck.caller import total\n"
+        "print(total(), sum(total.stats.cache_hits.values()))\n"
+    )
+    environment = {
+        **os.environ,
+        "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+        "PYTHONPATH": os.pathsep.join([str(package.parent), os.environ.get("PYTHONPATH", "")]),
+    }
+
+    def run() -> list[str]:
+        return subprocess.run(
+            [sys.executable, "-c", script],
+            env=environment,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.split()
+
+    assert run() == ["2.0", "0"]  # compiled
+    assert run() == ["2.0", "1"]  # loaded from the disk cache
+    callee.write_text(callee.read_text().replace("return 1.0", "return 5.25"))
+    assert run() == ["6.25", "0"]  # the edit of the callee recompiles the caller
+    assert run() == ["6.25", "1"]

@@ -3,29 +3,85 @@
 Dynamics, observers and control laws are pure functions of flat float arrays compiled with
 Numba, so that one environment step is a single compiled call. ``NUMBA_DISABLE_JIT=1`` in the
 environment runs the same functions as plain Python (for debugging and coverage).
+
+The machine code is cached on disk. Numba invalidates a cached function only when its own
+source file changes, yet a compiled function carries the code of the compiled functions it
+calls: after an edit of, say, ``core/rotations.py`` every caller in another file would load
+its old machine code and silently compute with the old rotations. The caches here therefore
+key every entry also by :func:`package_source_stamp`, which any edit of the package changes.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
+import importlib
 import inspect
 import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from numba import njit
 from numba.core.caching import FunctionCache
 
-jit = njit(cache=True, nogil=True)
-"""Decorator: compile a function in nopython mode, caching the machine code on disk."""
-
-parallel_jit = njit(cache=True, nogil=True, parallel=True)
-"""Decorator for batch precomputations: like :data:`jit`, and ``numba.prange`` loops run on all
-cores (``NUMBA_NUM_THREADS`` limits them)."""
-
 
 def _sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
+
+
+@functools.cache
+def package_source_stamp(package: str) -> str:
+    """A digest of the path, modification time and size of every ``.py`` file of the
+    top-level ``package`` (for a plain module, of its one file), computed once per process."""
+    module = importlib.import_module(package)
+    roots = list(getattr(module, "__path__", []))
+    files = [Path(root, name) for root in roots for name in sorted(_python_files(Path(root)))]
+    if not roots and getattr(module, "__file__", None):
+        files = [Path(module.__file__)]
+    entries = []
+    for path in files:
+        stat = path.stat()
+        entries.append((str(path), stat.st_mtime_ns, stat.st_size))
+    return _sha256(repr(entries).encode())
+
+
+def _python_files(root: Path) -> list[str]:
+    return [str(path.relative_to(root)) for path in root.rglob("*.py")]
+
+
+class PackageFunctionCache(FunctionCache):
+    """Numba's on-disk cache with each entry keyed also by the source stamp of the function's
+    top-level package, so that editing any module of it invalidates every cached function."""
+
+    def _index_key(self, sig: Any, codegen: Any) -> tuple[Any, ...]:
+        signature, magic, hashes = super()._index_key(sig, codegen)
+        return signature, magic, (*hashes, self._package_stamp())
+
+    def _package_stamp(self) -> str:
+        return package_source_stamp(self._py_func.__module__.partition(".")[0])
+
+
+def _with_cache(dispatcher: Any, cache: type[FunctionCache]) -> Any:
+    if hasattr(dispatcher, "py_func"):  # compiled (not NUMBA_DISABLE_JIT)
+        dispatcher._cache = cache(dispatcher.py_func)
+    return dispatcher
+
+
+_compile = njit(cache=True, nogil=True)
+_compile_parallel = njit(cache=True, nogil=True, parallel=True)
+
+
+def jit(function: Callable[..., Any]) -> Callable[..., Any]:
+    """Decorator: compile a function in nopython mode, caching the machine code on disk
+    (:class:`PackageFunctionCache`)."""
+    return _with_cache(_compile(function), PackageFunctionCache)
+
+
+def parallel_jit(function: Callable[..., Any]) -> Callable[..., Any]:
+    """Decorator for batch precomputations: like :func:`jit`, and ``numba.prange`` loops run on
+    all cores (``NUMBA_NUM_THREADS`` limits them)."""
+    return _with_cache(_compile_parallel(function), PackageFunctionCache)
 
 
 def compiled_function_identity(function: Any) -> tuple[Any, ...]:
@@ -54,7 +110,7 @@ def compiled_function_identity(function: Any) -> tuple[Any, ...]:
     )
 
 
-class ClosureFunctionCache(FunctionCache):
+class ClosureFunctionCache(PackageFunctionCache):
     """Numba's on-disk cache for a function that closes over other compiled functions.
 
     Numba keys a closure's cache entry by a pickle of the closed-over values, and a pickled
@@ -75,7 +131,7 @@ class ClosureFunctionCache(FunctionCache):
         return (
             sig,
             codegen.magic_tuple(),
-            (_sha256(self._py_func.__code__.co_code), _sha256(identity)),
+            (_sha256(self._py_func.__code__.co_code), _sha256(identity), self._package_stamp()),
         )
 
 
@@ -83,7 +139,4 @@ def closure_jit(function: Callable[..., Any]) -> Callable[..., Any]:
     """Like :data:`jit`, for a function defined inside a factory that closes over compiled
     functions (the problem kernels of the loop step): cached on disk with
     :class:`ClosureFunctionCache`, so that later processes load it instead of compiling."""
-    dispatcher = jit(function)
-    if hasattr(dispatcher, "py_func"):  # compiled (not NUMBA_DISABLE_JIT)
-        dispatcher._cache = ClosureFunctionCache(dispatcher.py_func)
-    return dispatcher
+    return _with_cache(_compile(function), ClosureFunctionCache)
