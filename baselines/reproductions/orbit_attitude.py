@@ -29,7 +29,6 @@ from baselines.plotting import plot_interevent, save
 from baselines.reproductions.report import Scenario, claim, metric_row
 from etsc_envs.orbit_attitude.closed_loop import disturbance_step
 from etsc_envs.orbit_attitude.dynamics import thruster_outputs
-from etsc_envs.orbit_attitude.env import STEADY_STATE_FRACTION
 
 PAPER = "000"
 TITLE = "ESO-based event-triggered orbit-attitude tracking for low-thrust spacecraft (Zhang 2019)"
@@ -151,7 +150,7 @@ def run_scenario(scenario: Scenario, progress: bool = False) -> Run:
 
 def _disturbance_steps(unwrapped: Any, times: np.ndarray, commands: np.ndarray) -> dict:
     """The largest jump of Ξ·Δd (torque and force parts) over the steady window's transmissions."""
-    steady_from = (1.0 - STEADY_STATE_FRACTION) * unwrapped.params.horizon_s
+    steady_from = unwrapped.constants.steady_start * unwrapped.params.sampling_period_s
     steps = np.array(
         [
             disturbance_step(before, after, unwrapped.model, unwrapped.gains)

@@ -35,19 +35,15 @@ def package_source_stamp(package: str) -> str:
     """A digest of the path, modification time and size of every ``.py`` file of the
     top-level ``package`` (for a plain module, of its one file), computed once per process."""
     module = importlib.import_module(package)
-    roots = list(getattr(module, "__path__", []))
-    files = [Path(root, name) for root in roots for name in sorted(_python_files(Path(root)))]
-    if not roots and getattr(module, "__file__", None):
-        files = [Path(module.__file__)]
+    if hasattr(module, "__path__"):
+        files = sorted(path for root in module.__path__ for path in Path(root).rglob("*.py"))
+    else:
+        files = [Path(module.__file__)] if getattr(module, "__file__", None) else []
     entries = []
     for path in files:
         stat = path.stat()
         entries.append((str(path), stat.st_mtime_ns, stat.st_size))
     return _sha256(repr(entries).encode())
-
-
-def _python_files(root: Path) -> list[str]:
-    return [str(path.relative_to(root)) for path in root.rglob("*.py")]
 
 
 class PackageFunctionCache(FunctionCache):
