@@ -1,0 +1,68 @@
+"""Output files that are either written whole or not at all.
+
+Every tool of the suite that writes results (JSON, plots, models, summaries) checks the
+destination before the work starts (:func:`require_writable_file`) and writes through a
+temporary file in the same folder followed by an atomic rename (:func:`atomic_write_text`,
+:func:`atomic_write_bytes`), so an interrupted or failed run never leaves a partly written
+file where a finished one is expected.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+
+def require_writable_file(path: str | Path, argument: str) -> Path:
+    """``path`` as a :class:`Path` if a file can be written there, else ``ValueError`` naming
+    ``argument``: the path is a folder, or a component of its parent is a file."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{argument} must name a file, got the folder {str(path)!r}")
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(
+                    f"{argument} cannot be written: {str(parent)!r} is a file, not a folder"
+                )
+            if not os.access(parent, os.W_OK):
+                raise ValueError(f"{argument} cannot be written: {str(parent)!r} is read-only")
+            break
+    return path
+
+
+def require_writable_folder(path: str | Path, argument: str) -> Path:
+    """``path`` as a :class:`Path` if it is, or can become, a writable folder, else
+    ``ValueError`` naming ``argument``."""
+    path = Path(path)
+    for candidate in (path, *path.parents):
+        if candidate.exists():
+            if not candidate.is_dir():
+                raise ValueError(f"{argument} cannot be a folder: {str(candidate)!r} is a file")
+            if not os.access(candidate, os.W_OK):
+                raise ValueError(f"{argument} cannot be written: {str(candidate)!r} is read-only")
+            break
+    return path
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` through a temporary file and a rename (parents created)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(descriptor, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def atomic_write_text(path: str | Path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file and a rename."""
+    return atomic_write_bytes(path, text.encode("utf-8"))
