@@ -1,10 +1,14 @@
 """Evaluate a trigger policy on an environment.
 
     python -m baselines.evaluate ENV_ID --policy POLICY [--policy-arg k=v ...]
-        [--env-arg k=v ...] [--episodes N] [--seed S] [--json PATH|-] [--plot DIR]
+        [--env-arg k=v ...] [--scenarios paper|validation|test [--set-size K]]
+        [--episodes N] [--seed S] [--json PATH|-] [--plot DIR]
 
 POLICY is ``paper`` (the paper's triggering rule), ``periodic`` (``--policy-arg every=K``),
-``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3 model).
+``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3 model). ``--scenarios`` runs a
+fixed scenario set of the test protocol (docs/protocol.md); ``--episodes/--seed`` run ad-hoc
+draws instead. The JSON holds every episode's record, the means, and the aggregates with 95 %
+intervals (mean, median, IQM of mean_cost, transmissions and return; failure rate).
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from typing import Any
 
 import gymnasium as gym
 
+from baselines.batch import run_batch
 from baselines.cli import (
     POLICY_CHOICES,
     episode_setup,
@@ -25,6 +30,9 @@ from baselines.cli import (
 )
 from baselines.episodes import mean_record
 from baselines.plotting import plot_episode
+from baselines.statistics import aggregate_lines, aggregate_records
+from etsc_envs.core.files import require_writable_file
+from etsc_envs.protocol import DEFAULT_SET_SIZE, SCENARIO_SET_NAMES, scenario_set
 
 
 def evaluate(
@@ -35,42 +43,74 @@ def evaluate(
     env_args: dict[str, Any] | None = None,
     episodes: int = 1,
     seed: int = 0,
+    scenarios: str | None = None,
+    set_size: int = DEFAULT_SET_SIZE,
     plot_dir: str | Path | None = None,
     progress: bool = False,
 ) -> dict[str, Any]:
-    """Run ``episodes`` episodes (seeds ``seed, seed+1, ...``) and return the design page's JSON.
+    """Run ``policy`` on a scenario set, or on ``episodes`` ad-hoc episodes (seeds ``seed,
+    seed+1, ...``), and return the design page's JSON with the protocol's aggregates.
 
-    Returns ``{"env", "policy", "policy_args", "env_args", "episodes": [...], "mean": {...}}``.
-    For a PettingZoo id (:data:`etsc_envs.PETTINGZOO_ENV_IDS`) one policy serves every agent
-    and the records also hold each agent's values under ``agents``.
+    Args:
+        scenarios: ``"paper"``, ``"validation"`` or ``"test"`` (:mod:`etsc_envs.protocol`);
+            when given, ``episodes`` and ``seed`` are not used.
+        set_size: scenarios of the validation or test set.
+        plot_dir: write one figure per episode (runs the episodes one by one).
+
+    Several episodes without plots run at once in the id's native vector env
+    (:func:`baselines.batch.run_batch`); the records equal the one-by-one runs'.
+
+    Returns ``{"env", "policy", "policy_args", "env_args", "scenarios", "episodes": [...],
+    "mean": {...}, "aggregates": {...}}``. For a PettingZoo id
+    (:data:`etsc_envs.PETTINGZOO_ENV_IDS`) one policy serves every agent and the records also
+    hold each agent's values under ``agents``.
     """
-    if episodes < 1:
-        raise ValueError(f"episodes must be >= 1, got {episodes}")
     policy_args, env_args = dict(policy_args or {}), dict(env_args or {})
-    env, make_trigger, runner = episode_setup(env_id, env_args)
-    trigger = make_trigger(policy, policy_args)
-    records = []
-    for episode in range(episodes):
-        record, trace = runner(
-            env,
+    if scenarios is not None:
+        chosen = scenario_set(scenarios, set_size)
+        env_args, seeds = chosen.env_kwargs(env_args), list(chosen.seeds)
+        described = chosen.describe()
+    else:
+        if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+            raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
+        seeds, described = [seed + episode for episode in range(episodes)], None
+    setup = episode_setup(env_id, env_args)
+    trigger = setup.make_policy(policy, policy_args)
+    if len(seeds) > 1 and plot_dir is None:
+        setup.env.close()
+        records = run_batch(
+            env_id,
             trigger,
-            seed + episode,
-            sample_every=None,
+            seeds,
+            env_args,
             progress=progress,
-            description=f"{policy} episode {episode + 1}/{episodes}",
+            description=f"{policy} on {len(seeds)} scenarios",
         )
-        records.append(record)
-        if plot_dir is not None:
-            title = f"{env_id} - {policy} {policy_args or ''} - seed {seed + episode}"
-            plot_episode(trace, Path(plot_dir) / f"episode_{episode:03d}.png", title)
-    env.close()
+    else:
+        records = []
+        for index, episode_seed in enumerate(seeds):
+            record, trace = setup.run(
+                setup.env,
+                trigger,
+                episode_seed,
+                sample_every=None,
+                progress=progress,
+                description=f"{policy} episode {index + 1}/{len(seeds)}",
+            )
+            records.append(record)
+            if plot_dir is not None:
+                title = f"{env_id} - {policy} {policy_args or ''} - seed {episode_seed}"
+                plot_episode(trace, Path(plot_dir) / f"episode_{index:03d}.png", title)
+        setup.env.close()
     return {
         "env": env_id,
         "policy": policy,
         "policy_args": policy_args,
         "env_args": env_args,
+        "scenarios": described,
         "episodes": records,
         "mean": mean_record(records),
+        "aggregates": aggregate_records(records),
     }
 
 
@@ -87,6 +127,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--policy", required=True, help=POLICY_CHOICES)
     parser.add_argument("--policy-arg", action="append", metavar="K=V", help="policy parameter")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
+    parser.add_argument(
+        "--scenarios",
+        choices=SCENARIO_SET_NAMES,
+        help="a fixed scenario set of the test protocol (instead of --episodes/--seed)",
+    )
+    parser.add_argument(
+        "--set-size",
+        type=int,
+        default=DEFAULT_SET_SIZE,
+        metavar="K",
+        help=f"scenarios of the validation or test set (default {DEFAULT_SET_SIZE})",
+    )
     parser.add_argument("--episodes", type=int, default=1)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", metavar="PATH|-", help="write the results as JSON")
@@ -94,6 +146,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     limit_torch_threads()
     try:
+        if args.json not in (None, "-"):
+            require_writable_file(args.json, "--json")
         result = evaluate(
             args.env_id,
             args.policy,
@@ -101,6 +155,8 @@ def main(argv: list[str] | None = None) -> int:
             env_args=parse_assignments(args.env_arg, "--env-arg"),
             episodes=args.episodes,
             seed=args.seed,
+            scenarios=args.scenarios,
+            set_size=args.set_size,
             plot_dir=args.plot,
             progress=sys.stderr.isatty(),
         )
@@ -108,14 +164,28 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(str(error))
     if args.json:
         write_json(result, args.json)
-    if args.json != "-":
-        print(f"{result['env']}  policy={result['policy']} {result['policy_args'] or ''}")
-        for key, value in result["mean"].items():
-            if not isinstance(value, dict):
-                print(f"  {key:>22s}  {value:.6g}")
-        for agent, values in result["mean"].get("agents", {}).items():
-            print(f"  {agent}: " + ", ".join(f"{k}={v:.6g}" for k, v in values.items()))
+    summary = sys.stderr if args.json == "-" else sys.stdout
+    print(_summary_text(result), file=summary)
     return 0
+
+
+def _summary_text(result: dict[str, Any]) -> str:
+    """The means of every numeric key and the aggregates with their 95 % intervals."""
+    scenarios = result["scenarios"]
+    where = (
+        f"{scenarios['name']} set, {scenarios['size']} scenario(s)"
+        if scenarios
+        else f"{len(result['episodes'])} episode(s)"
+    )
+    lines = [f"{result['env']}  policy={result['policy']} {result['policy_args'] or ''} ({where})"]
+    for key, value in result["mean"].items():
+        if isinstance(value, int | float):
+            lines.append(f"  {key:>22s}  {value:.6g}")
+    for agent, values in result["mean"].get("agents", {}).items():
+        lines.append(f"  {agent}: " + ", ".join(f"{k}={v:.6g}" for k, v in values.items()))
+    lines.append("  aggregates (95 % intervals):")
+    lines.extend(f"    {line}" for line in aggregate_lines(result["aggregates"]))
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

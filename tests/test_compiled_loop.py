@@ -224,6 +224,9 @@ class ToyEnv(EventTriggeredEnv):
     def _paper_metrics(self) -> dict[str, Any]:
         return {"final_x": self.state[0:2].tolist()}
 
+    def _settled_at_end(self, metrics: dict[str, Any]) -> bool:
+        return max(abs(x) for x in metrics["final_x"]) < 0.5 * CONSTANTS[BOUND]
+
 
 def test_env_reset_synchronises_the_channel_and_zeroes_the_clocks():
     env = ToyEnv()

@@ -410,6 +410,13 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
         """Whether the thrusters fire during the sampling period that starts now."""
         return bool(is_thrusting(self.time_s, self.burst_start_s, self.params.burst_duration_s))
 
+    def _settled_at_end(self, metrics: dict[str, Any]) -> bool:
+        """‖r‖ inside the shell r₀ ± ``shell_half_width_m`` at the horizon (the band the
+        barrier eq. (15) keeps the orbit in; the paper scenario never leaves it)."""
+        p = self.params
+        radius = float(np.linalg.norm(self.state[PLANT][0:3]))
+        return abs(radius - p.reference_radius_m) <= p.shell_half_width_m
+
     # ----------------------------------------------------------------- diagnostics
     def _attitude_error(self) -> np.ndarray:
         return error_quaternion(self.state[Q], self.state[DESIRED_ATTITUDE])

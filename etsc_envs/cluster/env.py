@@ -282,6 +282,11 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
             "agents": agents,
         }
 
+    def _settled_at_end(self, metrics: dict[str, Any]) -> bool:
+        """Every follower entered its containment neighbourhood and stayed (the paper's
+        convergence statement, ``converge_time_s`` exists)."""
+        return metrics["converge_time_s"] is not None
+
     def _omega_converge_time(self) -> float | None:
         """First time after which every ‖ω_i‖ stays below 5 % of the episode's peak."""
         last = int(self.state[LAST_FAST_STEP])

@@ -9,11 +9,12 @@ terminates the episode with ``info["failure"]`` and charges ``failure_cost`` for
 left to the horizon.
 
 A problem subclasses :class:`EventTriggeredEnv`, sets the class attribute ``kernels`` (its
-:class:`~etsc_envs.core.compiled_loop.ProblemKernels`) and implements three Python hooks:
+:class:`~etsc_envs.core.compiled_loop.ProblemKernels`) and implements four Python hooks:
 ``_reset_problem`` (write the initial state row from ``self.np_random``),
-``_failure_message`` (the text of a failure code) and ``_paper_metrics`` (the paper's episode
-metrics, read from the state row). Everything a step changes lives in the loop arrays, so a
-vector environment can bind many such environments to the rows of one batch
+``_failure_message`` (the text of a failure code), ``_paper_metrics`` (the paper's episode
+metrics, read from the state row) and ``_settled_at_end`` (the problem's own criterion of a
+settled loop at the horizon, reported as ``settled``). Everything a step changes lives in the
+loop arrays, so a vector environment can bind many such environments to the rows of one batch
 (:mod:`etsc_envs.core.vector_env`); Python attributes of a problem may be set by
 ``_reset_problem`` but never by a step.
 """
@@ -132,6 +133,11 @@ class EventTriggeredEnv(gym.Env):
         raise NotImplementedError
 
     def _paper_metrics(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def _settled_at_end(self, metrics: dict[str, Any]) -> bool:
+        """Whether the loop has settled by the problem's own criterion, judged at the horizon
+        from the state row and the paper's ``metrics`` of the episode."""
         raise NotImplementedError
 
     def _initial_held(self) -> np.ndarray:
@@ -253,10 +259,20 @@ class EventTriggeredEnv(gym.Env):
         return info
 
     def episode_metrics(self) -> dict[str, Any]:
-        """The design page's common metrics and the paper's own, for the episode so far."""
+        """The design page's common metrics and the paper's own, for the episode so far.
+
+        ``settled`` is true when the episode reached the horizon without failure and the loop
+        meets the problem's settling criterion there (``_settled_at_end``); the test protocol
+        asks it of the paper's trigger on every randomized scenario (docs/protocol.md)."""
         record = communication_metrics(self.arrays, self.time_s)
         record["failure"] = self.failure
-        record.update(self._paper_metrics())
+        paper_metrics = self._paper_metrics()
+        record.update(paper_metrics)
+        record["settled"] = bool(
+            record["failure"] is None
+            and self.step_index >= self.n_steps
+            and self._settled_at_end(paper_metrics)
+        )
         return record
 
     # ----------------------------------------------------------------- internals

@@ -17,9 +17,10 @@ COMMON_EPISODE_KEYS = (
     "mean_interevent_s",
     "min_interevent_s",
     "failure",
+    "settled",
 )
 """Keys every environment's ``episode_metrics`` carries (the design page's common record;
-``failure`` is added by the env, the paper's own metrics come beside them)."""
+``failure`` and ``settled`` are added by the env, the paper's own metrics come beside them)."""
 
 
 def interevent_summary(

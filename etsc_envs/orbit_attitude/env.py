@@ -399,6 +399,11 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             "thruster_impulse_Ns": float(state[IMPULSE]),
         }
 
+    def _settled_at_end(self, metrics: dict[str, Any]) -> bool:
+        """Both settling times exist: ‖Φ‖ and ‖χ‖ stay within :data:`SETTLING_BAND` of their
+        initial values from some instant to the horizon."""
+        return metrics["settle_att_s"] is not None and metrics["settle_pos_s"] is not None
+
     # ----------------------------------------------------------------- diagnostics
     def state_dict(self) -> dict[str, np.ndarray]:
         """Named copies of the loop's signals at the current instant (for plots and tests).

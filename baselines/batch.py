@@ -1,0 +1,157 @@
+"""Batch evaluation: every scenario of a set in one native vector env, one batched ``predict``
+per sampling instant.
+
+A set of ``K`` scenarios (seeds) runs as the ``K`` sub-environments of the id's native vector
+env (:mod:`etsc_envs.core.vector_env`), all stepped in one compiled call, and the policy is
+asked once per instant for the whole batch — for a PettingZoo id, once for every agent of
+every copy (``K × N`` observations, agent-minor, the layout of
+:class:`agents.vector_adapter.SharedPolicyVecEnv`). Sub-environment ``j`` reset with seed
+``s_j`` is the single environment reset with ``s_j`` (the vector env's contract), so a
+scenario's record here equals :func:`baselines.episodes.run_episode`'s (or
+:func:`~baselines.episodes.run_parallel_episode`'s) for the same seed, key for key; only
+``wall_time_s`` differs: it is the batch's wall time divided by ``K``. ``tests/test_batch.py``
+compares the two paths for every id.
+
+A sub-environment whose episode fails before the horizon is left to the vector env's
+next-step autoreset and ignored from then on; the batch ends when every scenario has ended
+once (all together at the horizon unless they fail).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode
+from tqdm import tqdm
+
+import etsc_envs
+from etsc_envs.core.multi_agent import agent_observation_index
+
+PROGRESS_EVERY = 1000
+"""Sampling instants between progress-bar updates."""
+
+
+def _vector_env(env_id: str, num_envs: int, env_args: dict[str, Any]) -> Any:
+    """The native vector env of ``env_id`` (of the shared loop for a PettingZoo id)."""
+    loop_id = etsc_envs.PETTINGZOO_LOOP_IDS.get(env_id, env_id)
+    if loop_id not in etsc_envs.VECTOR_ENTRY_POINTS:
+        raise ValueError(f"no native vector env for {env_id!r}")
+    return gym.make_vec(
+        loop_id,
+        num_envs=num_envs,
+        vectorization_mode="vector_entry_point",
+        autoreset_mode=AutoresetMode.NEXT_STEP,
+        **env_args,
+    ).unwrapped
+
+
+def run_batch(
+    env_id: str,
+    policy: Any,
+    seeds: Sequence[int],
+    env_args: dict[str, Any] | None = None,
+    *,
+    progress: bool = False,
+    description: str = "",
+) -> list[dict[str, Any]]:
+    """One episode per seed of ``seeds``, all at once; the records of the design page in seed
+    order (for a PettingZoo id with each agent's values under ``agents``).
+
+    Args:
+        env_id: a Gymnasium or PettingZoo id of the suite.
+        policy: anything with an SB3-style batched ``predict`` (for a PettingZoo id, one policy
+            for every agent, as :func:`baselines.cli.make_agent_policy` builds).
+        seeds: the reset seed of each scenario.
+        env_args: keywords of every scenario's env.
+        progress: show a progress bar over the sampling instants.
+    """
+    seeds = [int(seed) for seed in seeds]
+    if not seeds:
+        raise ValueError("seeds must name at least one scenario")
+    vector_env = _vector_env(env_id, len(seeds), dict(env_args or {}))
+    try:
+        return _run(env_id, vector_env, policy, seeds, progress, description)
+    finally:
+        vector_env.close()
+
+
+def _run(
+    env_id: str,
+    vector_env: Any,
+    policy: Any,
+    seeds: list[int],
+    progress: bool,
+    description: str,
+) -> list[dict[str, Any]]:
+    """:func:`run_batch` on an open vector env."""
+    rows = len(seeds)
+    loop = vector_env.envs[0]
+    multi_agent = env_id in etsc_envs.PETTINGZOO_ENV_IDS
+    agent_index = agent_observation_index(loop) if multi_agent else None
+    n_agents = loop.n_channels if multi_agent else 1
+
+    def policy_input(observations: np.ndarray) -> np.ndarray:
+        if agent_index is None:
+            return observations
+        return observations[:, agent_index].reshape(rows * n_agents, -1)
+
+    started = time.perf_counter()
+    observations, _ = vector_env.reset(seed=seeds)
+    returns = np.zeros((rows, n_agents))
+    running = np.ones(rows, dtype=bool)
+    ended_metrics: list[dict[str, Any] | None] = [None] * rows
+    state, episode_start = None, np.ones(rows * n_agents, dtype=bool)
+    not_started = np.zeros(rows * n_agents, dtype=bool)
+    bar = tqdm(
+        total=loop.n_steps,
+        disable=not progress,
+        desc=description,
+        unit="step",
+        leave=False,
+        mininterval=0.5,
+    )
+    steps = 0
+    while running.any():
+        actions, state = policy.predict(
+            policy_input(observations),
+            state=state,
+            episode_start=episode_start,
+            deterministic=True,
+        )
+        episode_start = not_started
+        actions = np.asarray(actions).reshape(rows, -1) if multi_agent else actions
+        observations, rewards, terminated, truncated, _ = vector_env.step(actions)
+        if multi_agent:
+            returns[running] += vector_env.channel_rewards[running]
+        else:
+            returns[running, 0] += rewards[running]
+        for row in np.flatnonzero(running & (terminated | truncated)):
+            ended_metrics[row] = vector_env.envs[row].episode_metrics()
+            running[row] = False
+        steps += 1
+        if steps % PROGRESS_EVERY == 0:
+            bar.update(PROGRESS_EVERY)
+    bar.close()
+    wall_time_s = (time.perf_counter() - started) / rows
+    names = tuple(getattr(loop, "agent_names", ()))
+    records = []
+    for row, seed in enumerate(seeds):
+        metrics = ended_metrics[row]
+        record = {
+            "seed": seed,
+            "wall_time_s": wall_time_s,
+            "return": float(returns[row].sum()) if multi_agent else float(returns[row, 0]),
+            **metrics,
+        }
+        if multi_agent:
+            agent_metrics = metrics.get("agents", {})
+            record["agents"] = {
+                agent: {"return": float(returns[row, i]), **agent_metrics.get(agent, {})}
+                for i, agent in enumerate(names)
+            }
+        records.append(record)
+    return records

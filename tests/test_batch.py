@@ -1,0 +1,106 @@
+"""The batch path (every scenario in one native vector env) equals the single-env path,
+scenario for scenario, for every id and every kind of policy."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from baselines.batch import run_batch
+from baselines.cli import episode_setup
+
+SHORT_HORIZONS = {
+    "etsc/AttitudeTracking-v0": 2.0,
+    "etsc/InnerFormation-v0": 2.0,
+    "etsc/OrbitAttitudeTracking-v0": 1.0,
+    "etsc/AsteroidOrbitKeeping-v0": 500.0,
+    "etsc/ClusterContainmentCentral-v0": 20.0,
+    "etsc/ClusterContainment-v0": 20.0,
+}
+"""About 2000 sampling instants of each id: long enough for every trigger to fire."""
+
+SEEDS = (2_000_000, 2_000_001, 2_000_002)
+MODEL = Path(__file__).resolve().parents[1] / "models" / "AttitudeTracking-v0_ppo.zip"
+
+
+def single_records(
+    env_id: str, spec: str, policy_args: dict[str, Any], env_args: dict[str, Any]
+) -> list[dict[str, Any]]:
+    setup = episode_setup(env_id, env_args)
+    policy = setup.make_policy(spec, policy_args)
+    records = [setup.run(setup.env, policy, seed)[0] for seed in SEEDS]
+    setup.env.close()
+    return records
+
+
+def batch_records(
+    env_id: str, spec: str, policy_args: dict[str, Any], env_args: dict[str, Any]
+) -> list[dict[str, Any]]:
+    setup = episode_setup(env_id, env_args)
+    policy = setup.make_policy(spec, policy_args)
+    setup.env.close()
+    return run_batch(env_id, policy, SEEDS, env_args)
+
+
+def assert_same_record(single: Any, batch: Any, where: str = "record") -> None:
+    """Equal key for key and bit for bit (NaN equals NaN), ``wall_time_s`` aside."""
+    if isinstance(single, dict):
+        assert set(single) == set(batch), where
+        for key in single:
+            if key != "wall_time_s":
+                assert_same_record(single[key], batch[key], f"{where}[{key!r}]")
+    elif isinstance(single, list | tuple):
+        assert len(single) == len(batch), where
+        for index, (a, b) in enumerate(zip(single, batch, strict=True)):
+            assert_same_record(a, b, f"{where}[{index}]")
+    elif isinstance(single, float) and math.isnan(single):
+        assert isinstance(batch, float) and math.isnan(batch), where
+    else:
+        assert single == batch, f"{where}: {single!r} != {batch!r}"
+
+
+@pytest.mark.parametrize("env_id", sorted(SHORT_HORIZONS))
+def test_batch_equals_single_env_for_the_paper_trigger(env_id: str) -> None:
+    env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
+    single = single_records(env_id, "paper", {}, env_args)
+    batch = batch_records(env_id, "paper", {}, env_args)
+    assert [record["seed"] for record in batch] == list(SEEDS)
+    assert len({record["transmissions"] for record in single}) > 1, "scenarios must differ"
+    for one, other in zip(single, batch, strict=True):
+        assert_same_record(one, other)
+
+
+@pytest.mark.parametrize(
+    ("env_id", "spec", "policy_args"),
+    [
+        ("etsc/InnerFormation-v0", "periodic", {"every": 7}),
+        ("etsc/ClusterContainment-v0", "periodic", {"every": 13}),
+        ("etsc/AsteroidOrbitKeeping-v0", "always", {}),
+        ("etsc/AttitudeTracking-v0", f"sb3:{MODEL}", {}),
+    ],
+)
+def test_batch_equals_single_env_for_clocks_and_learned_triggers(
+    env_id: str, spec: str, policy_args: dict[str, Any]
+) -> None:
+    if spec.startswith("sb3:"):
+        pytest.importorskip("stable_baselines3")
+    env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
+    single = single_records(env_id, spec, policy_args, env_args)
+    batch = batch_records(env_id, spec, policy_args, env_args)
+    for one, other in zip(single, batch, strict=True):
+        assert_same_record(one, other)
+
+
+def test_a_scenario_that_fails_early_keeps_its_own_record() -> None:
+    """A sub-environment that fails is recorded at its failure, the others run on."""
+    env_id = "etsc/AttitudeTracking-v0"
+    env_args = {"randomize": True, "horizon_s": 2.0, "max_rate_rad_s": 0.3}
+    single = single_records(env_id, "periodic", {"every": 400}, env_args)
+    batch = batch_records(env_id, "periodic", {"every": 400}, env_args)
+    failed = [record["failure"] is not None for record in single]
+    assert any(failed) and not all(failed), [record["failure"] for record in single]
+    for one, other in zip(single, batch, strict=True):
+        assert_same_record(one, other)
