@@ -14,6 +14,8 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``n_envs: 1`` — environments stepped together (in the id's native vector env, one compiled
   call per step);
 * ``seed: 0`` — seeds the algorithm and the environments (``null`` leaves them unseeded);
+  environment ``j`` is seeded ``seed + j``, and a seed range that reaches into the protocol's
+  validation or test seeds is refused (:func:`etsc_envs.protocol.require_training_seeds`);
 * ``out_dir`` — where the model, the resolved config and the summary are written;
 * ``normalize_observations: true`` — train on observations standardised by running
   statistics (SB3's ``VecNormalize``), saved beside the model for evaluation;
@@ -24,11 +26,13 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``normalize_rewards: false`` — also scale rewards by a running estimate of the return;
 * ``checkpoint_every: 0`` — save the model (and the statistics) every that many steps into
   ``out_dir/checkpoints``, from which ``--resume`` continues; 0 saves no checkpoints;
-* ``evaluation_every: 0`` — every that many steps, run the current policy and the paper's
-  trigger on the paper scenario and log both (TensorBoard and ``out_dir/evaluations.json``);
-  0 never evaluates;
-* ``evaluation_env_kwargs: {}`` — env kwargs of that evaluation on top of the paper scenario
-  (``randomize`` is always false there), e.g. a shorter ``horizon_s``;
+* ``evaluation_every: 0`` — every that many steps, run the current policy on the protocol's
+  validation scenarios (the paper's trigger once, at the start) and log both (TensorBoard and
+  ``out_dir/evaluations.json``), keeping the best model by mean validation return in
+  ``out_dir/best_model.zip``; 0 never evaluates;
+* ``evaluation_scenarios: 16`` — validation scenarios per evaluation (the first of the set);
+* ``evaluation_env_kwargs: {}`` — env kwargs of that evaluation on top of the training ones
+  (the set's ``randomize`` replaces theirs), e.g. a shorter ``horizon_s``;
 * ``tensorboard: true`` — write TensorBoard logs into ``out_dir/tensorboard``;
 * ``init_from: null`` — a model saved by an earlier run (``model.zip`` or a checkpoint) to
   start from: its weights and, when saved beside it, its observation and return statistics
@@ -61,6 +65,7 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
+from etsc_envs.protocol import require_training_seeds
 
 ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"PPO": PPO, "A2C": A2C, "DQN": DQN}
 """Algorithm name in a config → Stable-Baselines3 class."""
@@ -79,6 +84,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "observation_clip": 10.0,
     "checkpoint_every": 0,
     "evaluation_every": 0,
+    "evaluation_scenarios": 16,
     "evaluation_env_kwargs": {},
     "tensorboard": True,
     "torch_threads": 1,
@@ -109,6 +115,7 @@ class TrainConfig:
     observation_clip: float
     checkpoint_every: int
     evaluation_every: int
+    evaluation_scenarios: int
     evaluation_env_kwargs: dict[str, Any]
     tensorboard: bool
     torch_threads: int
@@ -145,6 +152,10 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
             "from an earlier model or from the cloned paper trigger, not both"
         )
     algorithm = _check_algorithm(values["algorithm"])
+    seed = _check_seed(values["seed"])
+    n_envs = _check_positive_int("n_envs", values["n_envs"])
+    if seed is not None:
+        require_training_seeds(seed, n_envs, "config key 'seed'")
     env_id = _check_env_id(values["env_id"])
     env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
     _check_algorithm_fits_env(algorithm, env_id, env_kwargs)
@@ -155,8 +166,8 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         policy=_check_policy(values["policy"], algorithm),
         hyperparameters=_check_hyperparameters(values["hyperparameters"], algorithm),
         total_timesteps=_check_positive_int("total_timesteps", values["total_timesteps"]),
-        n_envs=_check_positive_int("n_envs", values["n_envs"]),
-        seed=_check_seed(values["seed"]),
+        n_envs=n_envs,
+        seed=seed,
         out_dir=_check_out_dir(values["out_dir"]),
         normalize_observations=_check_bool(
             "normalize_observations", values["normalize_observations"]
@@ -165,6 +176,9 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         observation_clip=_check_positive_float("observation_clip", values["observation_clip"]),
         checkpoint_every=_check_non_negative_int("checkpoint_every", values["checkpoint_every"]),
         evaluation_every=_check_non_negative_int("evaluation_every", values["evaluation_every"]),
+        evaluation_scenarios=_check_positive_int(
+            "evaluation_scenarios", values["evaluation_scenarios"]
+        ),
         evaluation_env_kwargs=_check_mapping(
             "evaluation_env_kwargs", values["evaluation_env_kwargs"]
         ),

@@ -1,4 +1,9 @@
-"""Scoring a policy in training against the paper's trigger on the paper scenario."""
+"""Scoring a policy during training against the paper's trigger on the validation scenarios.
+
+Model selection follows the test protocol (``docs/protocol.md``): the training run is scored
+on the *validation* set only (the test set is for reporting), all its scenarios at once in the
+native vector env (:func:`baselines.batch.run_batch`), and the best-scoring model is kept.
+"""
 
 from __future__ import annotations
 
@@ -7,14 +12,18 @@ import pickle
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
-from baselines.cli import EpisodeSetup, episode_setup
+from baselines.batch import run_batch
+from baselines.cli import episode_setup
 from baselines.episodes import to_jsonable
-from baselines.policies import NormalizedModel
+from baselines.policies import NormalizedModel, normalization_path
+from etsc_envs.core.files import atomic_write_text
+from etsc_envs.protocol import scenario_set
 
 COMPARED_KEYS = ("mean_cost", "transmissions", "transmission_rate", "failure")
-"""What an evaluation records of each episode (the two axes of the comparison and failure)."""
+"""What a one-episode summary records (the two axes of the comparison and failure)."""
 
 
 def episode_summary(record: dict[str, Any]) -> dict[str, Any]:
@@ -22,58 +31,103 @@ def episode_summary(record: dict[str, Any]) -> dict[str, Any]:
     return {key: to_jsonable(record[key]) for key in COMPARED_KEYS}
 
 
+def set_summary(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """Means over a scenario set of ``mean_cost``, ``transmissions``, ``transmission_rate``
+    and ``return``, and the number of failed episodes."""
+    summary: dict[str, Any] = {
+        key: float(np.mean([record[key] for record in records]))
+        for key in ("mean_cost", "transmissions", "transmission_rate", "return")
+    }
+    summary["failures"] = sum(record["failure"] is not None for record in records)
+    return summary
+
+
 class PaperComparisonCallback(BaseCallback):
-    """Every ``every`` training steps, run the current policy for one episode of the paper
-    scenario and log it beside the paper trigger's episode (run once, at the start).
+    """Every ``every`` training steps, run the current policy on the validation scenarios and
+    log it beside the paper trigger's run of the same scenarios (run once, at the start).
 
     Args:
         env_id: the trained environment's id.
-        env_kwargs: kwargs of the evaluation env (``randomize`` is forced false, so that the
-            scenario is the paper's).
+        env_kwargs: kwargs of the evaluation envs (the set's ``randomize`` replaces theirs).
         every: training steps between evaluations.
-        out_path: JSON file that receives the list of evaluations after each one.
+        out_path: JSON file that receives the list of evaluations after each one (each entry
+            ``{"timesteps", "learned": {...}, "paper": {...}}`` with :func:`set_summary`'s keys).
+        set_size: validation scenarios per evaluation.
+        best_model_path: where the model with the highest mean validation return so far is
+            saved (with its observation statistics beside it), or ``None``.
 
-    Logged (TensorBoard and SB3's logger): ``eval/mean_cost``, ``eval/transmissions`` and the
-    paper trigger's ``eval/paper_mean_cost``, ``eval/paper_transmissions``.
+    Logged (TensorBoard and SB3's logger): ``eval/mean_cost``, ``eval/transmissions``,
+    ``eval/return`` and the paper trigger's ``eval/paper_mean_cost``,
+    ``eval/paper_transmissions``.
     """
 
     def __init__(
-        self, env_id: str, env_kwargs: dict[str, Any], every: int, out_path: str | Path
+        self,
+        env_id: str,
+        env_kwargs: dict[str, Any],
+        every: int,
+        out_path: str | Path,
+        set_size: int,
+        best_model_path: str | Path | None = None,
     ) -> None:
         super().__init__()
         self.env_id = env_id
-        self.env_kwargs = {**env_kwargs, "randomize": False}
+        self.scenarios = scenario_set("validation", set_size)
+        base = {key: value for key, value in env_kwargs.items() if key != "randomize"}
+        self.env_kwargs = self.scenarios.env_kwargs(base)
         self.every = every
         self.out_path = Path(out_path)
+        self.best_model_path = None if best_model_path is None else Path(best_model_path)
         self.evaluations: list[dict[str, Any]] = []
         self.paper: dict[str, Any] = {}
+        self.best_return = -np.inf
         self._next_evaluation = every
-        self._setup: EpisodeSetup | None = None
 
     def _on_training_start(self) -> None:
-        self._setup = episode_setup(self.env_id, self.env_kwargs)
-        record, _ = self._setup.run(self._setup.env, self._setup.make_policy("paper", {}), seed=0)
-        self.paper = episode_summary(record)
+        setup = episode_setup(self.env_id, self.env_kwargs)
+        paper_trigger = setup.make_policy("paper", {})
+        setup.env.close()
+        self.paper = set_summary(self._run(paper_trigger))
         self._next_evaluation = self.num_timesteps + self.every
 
     def _on_step(self) -> bool:
         if self.num_timesteps < self._next_evaluation:
             return True
         self._next_evaluation += self.every
-        record, _ = self._setup.run(self._setup.env, self._current_policy(), seed=0)
-        learned = episode_summary(record)
+        learned = set_summary(self._run(self._current_policy()))
         self.evaluations.append(
-            {"timesteps": self.num_timesteps, "learned": learned, "paper": self.paper}
+            {
+                "timesteps": self.num_timesteps,
+                "scenarios": self.scenarios.describe(),
+                "learned": learned,
+                "paper": self.paper,
+            }
         )
         for name, summary in (("", learned), ("paper_", self.paper)):
             self.logger.record(f"eval/{name}mean_cost", summary["mean_cost"])
             self.logger.record(f"eval/{name}transmissions", summary["transmissions"])
-        self.out_path.write_text(json.dumps(self.evaluations, indent=2) + "\n", encoding="utf-8")
+        self.logger.record("eval/return", learned["return"])
+        if self.best_model_path is not None and learned["return"] > self.best_return:
+            self.best_return = learned["return"]
+            self._save_best()
+        atomic_write_text(self.out_path, json.dumps(to_jsonable(self.evaluations), indent=2))
         return True
 
-    def _on_training_end(self) -> None:
-        if self._setup is not None:
-            self._setup.env.close()
+    def _run(self, policy: Any) -> list[dict[str, Any]]:
+        return run_batch(self.env_id, policy, self.scenarios.seeds, self.env_kwargs)
+
+    def _save_best(self) -> None:
+        """The current model (and statistics) as the best so far, each file replaced whole."""
+        path = self.best_model_path
+        path.parent.mkdir(parents=True, exist_ok=True)
+        temporary = path.with_name(f".{path.stem}.partial.zip")
+        self.model.save(temporary)
+        temporary.replace(path)
+        normalization = self.model.get_vec_normalize_env()
+        if normalization is not None:
+            partial_statistics = normalization_path(temporary)
+            normalization.save(partial_statistics)
+            partial_statistics.replace(normalization_path(path))
 
     def _current_policy(self) -> Any:
         """The model, reading observations through a frozen copy of the training statistics."""

@@ -1,40 +1,53 @@
-"""Accuracy against transmissions: the paper's trigger, periodic sampling and learned triggers.
+"""Accuracy against transmissions: the paper's trigger, periodic sampling and learned triggers,
+under the test protocol.
 
-    python -m agents.pareto ENV_ID [--model PATH ...] [--env-arg k=v ...] [--seed S]
-                                   [--out DIR] [--reuse PARETO_JSON]
+    python -m agents.pareto ENV_ID [--model PATH ...] [--scenarios test|validation]
+                                   [--set-size K] [--env-arg k=v ...] [--out DIR]
+                                   [--reuse PARETO_JSON]
 
-Runs one episode of the paper scenario (``randomize`` off) for every point of three curves and
-plots ``mean_cost`` (the per-step accuracy cost the reward penalises) against the number of
-transmissions:
+Every point of three curves runs on a scenario set of the protocol (default the test set, all
+its scenarios at once in the native vector env) and on the paper scenario:
 
 * the paper's trigger over a sweep of its threshold (:data:`PAPER_SWEEPS`: Ψ for 002, γ1 and
   γ2 for 000, c for 001, α for 003, Π for 004), the paper's own value included;
-* periodic transmission every ``k`` sampling instants (:func:`periodic_sweep`);
+* periodic transmission every ``k`` sampling instants (:func:`periodic_sweep`), wide enough
+  to reach periods at which the clock fails;
 * each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
   typically one per transmission penalty λ.
 
+A point records the set's aggregates (mean ``mean_cost`` and transmissions with 95 % bootstrap
+intervals, failures) and the paper scenario's episode. The plot shows each curve's
+non-dominated points joined, with interval bars on both axes, dominated points faint, points
+with failures crossed, and the paper scenario in a second panel.
+
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
 ``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper and periodic curves of
-an earlier run (same id, kwargs and seed) and runs only the models.
+an earlier run (same id, kwargs and scenario set) and runs only the models.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import matplotlib.pyplot as plt
+from matplotlib import ticker
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.evaluation import episode_summary
-from baselines.cli import EpisodeSetup, episode_setup, limit_torch_threads, parse_assignments
+from baselines.cli import limit_torch_threads, parse_assignments, write_json
+from baselines.evaluate import evaluate
 from baselines.plotting import save
 from baselines.triggers.asteroid import PAPER_ALPHA
 from baselines.triggers.attitude_tracking import PAPER_PSI
 from baselines.triggers.inner_formation import default_thresholds
 from baselines.triggers.orbit_attitude import PAPER_GAMMA
+from etsc_envs.core.files import require_writable_folder
+from etsc_envs.protocol import DEFAULT_SET_SIZE
 
 SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
 """Multiples of the paper's threshold swept where the threshold is a free positive number."""
@@ -66,16 +79,16 @@ PAPER_SWEEPS = {
 }
 """Id → the paper-trigger arguments of each point (the paper's own values among them)."""
 
-PERIODIC_EVERY = (1, 2, 5, 10, 20, 50, 100, 200)
+PERIODIC_EVERY = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000)
 """Sampling instants between periodic transmissions."""
 
 PERIODIC_EVERY_BY_ID = {
     # A burst fires for 50 s = 200 sampling instants, so requests closer than that all land
     # inside a running burst: periodic bursts start 200 instants apart at the closest.
-    "etsc/AsteroidOrbitKeeping-v0": (200, 240, 300, 400, 600, 800, 1200, 1600),
+    "etsc/AsteroidOrbitKeeping-v0": (200, 240, 300, 400, 600, 800, 1200, 1600, 2400, 4800),
     # The paper's trigger updates a follower every few seconds (hundreds of 0.01-s instants).
-    "etsc/ClusterContainmentCentral-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000),
-    "etsc/ClusterContainment-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000),
+    "etsc/ClusterContainmentCentral-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000, 10000),
+    "etsc/ClusterContainment-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000, 10000),
 }
 """Ids whose periodic sweep differs from :data:`PERIODIC_EVERY`."""
 
@@ -86,89 +99,210 @@ def periodic_sweep(env_id: str) -> tuple[int, ...]:
 
 
 def run_point(
-    setup: EpisodeSetup, policy_spec: str, policy_args: dict[str, Any], seed: int
+    env_id: str,
+    policy_spec: str,
+    policy_args: dict[str, Any],
+    env_kwargs: dict[str, Any],
+    scenarios: str,
+    set_size: int,
 ) -> dict[str, Any]:
-    """One paper-scenario episode of a policy: its compared metrics and what it was."""
-    policy = setup.make_policy(policy_spec, policy_args)
-    record, _ = setup.run(setup.env, policy, seed=seed)
-    return {"policy": policy_spec, "args": policy_args, **episode_summary(record)}
+    """One point: the policy on the scenario set (aggregates) and on the paper scenario."""
+    print(f"{env_id}: {policy_spec} {policy_args or ''}", file=sys.stderr, flush=True)
+    on_set = evaluate(
+        env_id,
+        policy_spec,
+        policy_args=policy_args,
+        env_args=env_kwargs,
+        scenarios=scenarios,
+        set_size=set_size,
+        progress=sys.stderr.isatty(),
+    )
+    on_paper = evaluate(
+        env_id, policy_spec, policy_args=policy_args, env_args=env_kwargs, scenarios="paper"
+    )
+    aggregates = on_set["aggregates"]
+    return {
+        "policy": policy_spec,
+        "args": policy_args,
+        "mean_cost": aggregates["mean_cost"],
+        "transmissions": aggregates["transmissions"],
+        "failures": aggregates["failure"]["count"],
+        "paper_scenario": episode_summary(on_paper["episodes"][0]),
+    }
 
 
 def pareto(
     env_id: str,
     models: list[str],
     env_kwargs: dict[str, Any],
-    seed: int = 0,
+    scenarios: str = "test",
+    set_size: int = DEFAULT_SET_SIZE,
     reuse: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The three curves of the module docstring for ``env_id``; with ``reuse`` (an earlier
-    result of the same id, kwargs and seed), its paper and periodic curves are kept and only
-    the models run."""
+    result of the same id, kwargs and scenario set), its paper and periodic curves are kept and
+    only the models run."""
     if env_id not in PAPER_SWEEPS:
         raise ValueError(f"no Pareto sweep for {env_id}; known: {sorted(PAPER_SWEEPS)}")
+    if scenarios not in ("test", "validation"):
+        raise ValueError(f"--scenarios must be 'test' or 'validation', got {scenarios!r}")
+    identity = (env_id, env_kwargs, scenarios, set_size)
     if reuse is not None:
-        earlier = (reuse.get("env"), reuse.get("env_kwargs"), reuse.get("seed"))
-        if earlier != (env_id, env_kwargs, seed):
+        earlier = tuple(reuse.get(key) for key in ("env", "env_kwargs", "scenarios", "set_size"))
+        if earlier != identity:
             raise ValueError(
-                f"--reuse: that result is of (env, env_kwargs, seed) = {earlier}, "
-                f"not {(env_id, env_kwargs, seed)}"
+                f"--reuse: that result is of (env, env_kwargs, scenarios, set_size) = "
+                f"{earlier}, not {identity}"
             )
-    setup = episode_setup(env_id, {**env_kwargs, "randomize": False})
+
+    def point(spec: str, args: dict[str, Any]) -> dict[str, Any]:
+        return run_point(env_id, spec, args, env_kwargs, scenarios, set_size)
+
     if reuse is None:
         curves = {
-            "paper": [run_point(setup, "paper", args, seed) for args in PAPER_SWEEPS[env_id]()],
-            "periodic": [
-                run_point(setup, "periodic", {"every": every}, seed)
-                for every in periodic_sweep(env_id)
-            ],
+            "paper": [point("paper", args) for args in PAPER_SWEEPS[env_id]()],
+            "periodic": [point("periodic", {"every": k}) for k in periodic_sweep(env_id)],
         }
     else:
         curves = {name: reuse["curves"][name] for name in ("paper", "periodic")}
-    curves["learned"] = [run_point(setup, f"sb3:{path}", {}, seed) for path in models]
-    setup.env.close()
-    return {"env": env_id, "env_kwargs": env_kwargs, "seed": seed, "curves": curves}
-
-
-def plot(result: dict[str, Any], path: Path) -> None:
-    """``mean_cost`` against transmissions, one marker style per curve (log-log axes; the cost
-    axis is linear near zero when some cost is exactly zero)."""
-    figure, axes = plt.subplots(figsize=(6.0, 4.5))
-    styles = {"paper": "o-", "periodic": "s--", "learned": "*"}
-    labels = {
-        "paper": "paper trigger (threshold sweep)",
-        "periodic": "periodic",
-        "learned": "learned",
+    curves["learned"] = [point(f"sb3:{path}", {}) for path in models]
+    return {
+        "env": env_id,
+        "env_kwargs": env_kwargs,
+        "scenarios": scenarios,
+        "set_size": set_size,
+        "curves": curves,
     }
+
+
+def non_dominated(points: list[dict[str, Any]], cost: Any, sent: Any) -> list[dict[str, Any]]:
+    """The points no other point beats on both axes (fewer transmissions and lower cost),
+    sorted by transmissions."""
+    front, best_cost = [], float("inf")
+    for candidate in sorted(points, key=lambda p: (sent(p), cost(p))):
+        if cost(candidate) < best_cost:
+            front.append(candidate)
+            best_cost = cost(candidate)
+    return front
+
+
+STYLES = {
+    "paper": ("o", "-", "C0", "paper trigger (threshold sweep)"),
+    "periodic": ("s", "--", "C1", "periodic (clock)"),
+    "learned": ("*", ":", "C3", "learned"),
+}
+
+
+def _draw_set(axes: plt.Axes, result: dict[str, Any]) -> None:
+    """Means with interval bars; fronts joined, dominated points faint, failures crossed."""
     for name, points in result["curves"].items():
-        finished = [p for p in points if p["failure"] is None and p["transmissions"] > 0]
-        if not finished:
-            continue
-        finished.sort(key=lambda point: point["transmissions"])
-        axes.plot(
-            [point["transmissions"] for point in finished],
-            [point["mean_cost"] for point in finished],
-            styles[name],
-            label=labels[name],
-            markersize=10 if name == "learned" else 5,
+        marker, line, color, _ = STYLES[name]
+        usable = [p for p in points if p["transmissions"]["mean"] > 0]
+        failed = [p for p in usable if p["failures"]]
+        finished = [p for p in usable if not p["failures"]]
+        front = non_dominated(
+            finished, lambda p: p["mean_cost"]["mean"], lambda p: p["transmissions"]["mean"]
         )
-    axes.set_xscale("log")
-    costs = [
-        point["mean_cost"]
-        for points in result["curves"].values()
-        for point in points
-        if point["failure"] is None
+        for group, alpha in ((finished, 0.25), (front, 1.0)):
+            if not group:
+                continue
+            axes.errorbar(
+                [p["transmissions"]["mean"] for p in group],
+                [p["mean_cost"]["mean"] for p in group],
+                xerr=_bars([p["transmissions"] for p in group]),
+                yerr=_bars([p["mean_cost"] for p in group]),
+                fmt=marker + (line if group is front else ""),
+                color=color,
+                alpha=alpha,
+                markersize=9 if name == "learned" else 5,
+                capsize=2,
+                linewidth=1.2,
+            )
+        if failed:
+            axes.plot(
+                [p["transmissions"]["mean"] for p in failed],
+                [p["mean_cost"]["mean"] for p in failed],
+                "x",
+                color=color,
+                markersize=8,
+            )
+
+
+def _bars(summaries: list[dict[str, Any]]) -> list[list[float]]:
+    return [
+        [max(s["mean"] - s["mean_ci95"][0], 0.0) for s in summaries],
+        [max(s["mean_ci95"][1] - s["mean"], 0.0) for s in summaries],
     ]
+
+
+def _draw_paper_scenario(axes: plt.Axes, result: dict[str, Any]) -> None:
+    for name, points in result["curves"].items():
+        marker, line, color, _ = STYLES[name]
+        scenario = [p["paper_scenario"] for p in points if p["paper_scenario"]["transmissions"]]
+        finished = [p for p in scenario if p["failure"] is None]
+        front = non_dominated(finished, lambda p: p["mean_cost"], lambda p: p["transmissions"])
+        axes.plot(
+            [p["transmissions"] for p in finished],
+            [p["mean_cost"] for p in finished],
+            marker,
+            color=color,
+            alpha=0.25,
+        )
+        axes.plot(
+            [p["transmissions"] for p in front],
+            [p["mean_cost"] for p in front],
+            marker + line,
+            color=color,
+            markersize=9 if name == "learned" else 5,
+        )
+        failed = [p for p in scenario if p["failure"] is not None]
+        axes.plot(
+            [p["transmissions"] for p in failed],
+            [p["mean_cost"] for p in failed],
+            "x",
+            color=color,
+            markersize=8,
+        )
+
+
+def _log_axes(axes: plt.Axes, costs: list[float]) -> None:
+    """Log transmissions; log cost (symlog when a cost is 0), major labels only."""
+    axes.set_xscale("log")
     positive = [cost for cost in costs if cost > 0]
     if positive and len(positive) == len(costs):
         axes.set_yscale("log")
     else:  # a zero cost (paper 003 inside its shell) has no place on a log axis
         axes.set_yscale("symlog", linthresh=min(positive, default=1.0))
         axes.set_ylim(bottom=0.0)
-    axes.set_xlabel("transmissions per episode")
-    axes.set_ylabel("mean_cost (accuracy cost per step)")
-    axes.set_title(f"{result['env']}: accuracy against communication", fontsize=10)
-    axes.legend()
+    for axis in (axes.xaxis, axes.yaxis):
+        axis.set_minor_formatter(ticker.NullFormatter())
+    axes.xaxis.set_major_locator(ticker.LogLocator(numticks=6))
     axes.grid(True, which="both", alpha=0.3)
+    axes.set_xlabel("transmissions per episode")
+
+
+def plot(result: dict[str, Any], path: Path) -> None:
+    """The scenario set's curves (left, with intervals) and the paper scenario's (right)."""
+    figure, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.8))
+    _draw_set(left, result)
+    _draw_paper_scenario(right, result)
+    points = [p for curve in result["curves"].values() for p in curve]
+    _log_axes(left, [p["mean_cost"]["mean"] for p in points])
+    _log_axes(right, [p["paper_scenario"]["mean_cost"] for p in points])
+    left.set_ylabel("mean_cost (accuracy cost per step)")
+    left.set_title(
+        f"{result['scenarios']} set, {result['set_size']} scenarios: mean, 95 % intervals",
+        fontsize=10,
+    )
+    right.set_title("paper scenario", fontsize=10)
+    handles = [
+        plt.Line2D([], [], marker=marker, linestyle=line, color=color, label=label)
+        for marker, line, color, label in STYLES.values()
+    ]
+    handles.append(plt.Line2D([], [], marker="x", linestyle="", color="k", label="with failures"))
+    figure.legend(handles=handles, loc="lower center", ncol=4, frameon=False)
+    figure.suptitle(f"{result['env']}: accuracy against communication", fontsize=11)
+    figure.tight_layout(rect=(0, 0.08, 1, 0.95))
     save(figure, path)
 
 
@@ -182,8 +316,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--model", action="append", default=[], help="an SB3 zip of a learned trigger (repeatable)"
     )
+    parser.add_argument("--scenarios", choices=("test", "validation"), default="test")
+    parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
-    parser.add_argument("--seed", type=int, default=0, help="reset seed of every episode")
     parser.add_argument("--out", type=Path, help="output folder")
     parser.add_argument(
         "--reuse",
@@ -193,21 +328,22 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     limit_torch_threads()
+    out_dir = args.out or Path("results") / "pareto" / args.env_id.split("/")[-1]
     try:
+        require_writable_folder(out_dir, "--out")
         env_kwargs = parse_assignments(args.env_arg, "--env-arg")
         reuse = json.loads(args.reuse.read_text(encoding="utf-8")) if args.reuse else None
-        result = pareto(args.env_id, args.model, env_kwargs, args.seed, reuse)
-    except ValueError as error:
+        result = pareto(args.env_id, args.model, env_kwargs, args.scenarios, args.set_size, reuse)
+    except (ValueError, TypeError, OSError, gym.error.Error) as error:
         parser.error(str(error))
-    out_dir = args.out or Path("results") / "pareto" / args.env_id.split("/")[-1]
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "pareto.json").write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    write_json(result, str(out_dir / "pareto.json"))
     plot(result, out_dir / "pareto.png")
     for name, points in result["curves"].items():
         for point in points:
+            cost, sent = point["mean_cost"], point["transmissions"]
             print(
-                f"{name:9s} {json.dumps(point['args']):48s} mean_cost {point['mean_cost']:.4g}  "
-                f"transmissions {point['transmissions']}"
+                f"{name:9s} {json.dumps(point['args'])[:40]:40s} mean_cost {cost['mean']:.4g} "
+                f"transmissions {sent['mean']:.4g} failures {point['failures']}"
             )
     print(f"wrote {out_dir / 'pareto.json'} and {out_dir / 'pareto.png'}")
     return 0

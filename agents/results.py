@@ -1,43 +1,59 @@
-"""A learned trigger against the paper's trigger and periodic sampling: the rows of
-``docs/results.md``.
+"""A learned trigger against the paper's trigger and the clock, under the test protocol: the
+rows of ``docs/results.md``.
 
-    python -m agents.results ENV_ID --model PATH [--randomized-episodes K] [--env-arg k=v ...]
-                                    [--out DIR]
+    python -m agents.results ENV_ID --model PATH [--model PATH ...]
+                             [--scenarios paper test] [--set-size K] [--env-arg k=v ...]
+                             [--out DIR]
 
-On the paper scenario (``randomize`` off, seed 0) it runs the paper's trigger, the learned
-model and periodic transmission at the learned model's rate (every ``k`` sampling instants on
-every channel, ``k`` chosen so that the transmission counts match); on ``K`` randomized
-scenarios (seeds :data:`RANDOMIZED_SEED` onwards, which training never draws: training envs
-draw every reset from one generator seeded with the config's seed) it runs the paper's trigger
-and the learned model. For each it records ``mean_cost``, the transmissions and the paper's own
-metrics (:data:`PAPER_KEYS`), and it judges the goal: ``mean_cost`` at most
-:data:`COST_TOLERANCE` above the paper trigger's with at least :data:`TRANSMISSION_SAVING`
-fewer transmissions.
+For each scenario set (:mod:`etsc_envs.protocol`; default the paper scenario and the test set)
+it runs the paper's trigger, every ``--model`` (several models are training seeds of one
+method), and, for each model, periodic transmission at that model's own rate (every ``k``
+sampling instants on every channel, ``k`` matching the model's mean transmissions on the set).
+All scenarios of a set run at once in the native vector env (:mod:`baselines.batch`).
 
-Writes ``results.json`` into ``DIR`` (default ``results/<env name>``) and prints the table as
-Markdown.
+Per set and model it reports the paired per-scenario ratios with 95 % bootstrap intervals
+(:mod:`baselines.statistics`) and the goal's verdicts, which hold only when the interval
+supports them:
+
+* **goal vs the paper** — the upper bound of the cost ratio (IQM of the per-scenario ratios
+  learned / paper) at most :data:`COST_RATIO_MAX`, the upper bound of the transmission ratio at
+  most :data:`TRANSMISSION_RATIO_MAX`, and no more failures than the paper's trigger;
+* **beats periodic** — the upper bound of the cost ratio learned / periodic at the learned rate
+  at most 1, and no more failures than the clock.
+
+With three or more models the method's verdicts use the IQM over seeds × scenarios with
+rliable's stratified bootstrap interval, and the range of the per-seed IQMs; with fewer, the
+page states that there is no claim (a claim stands on at least :data:`MIN_CLAIM_SEEDS` seeds).
+
+Writes ``results.json`` (every episode record included) into ``DIR`` (default
+``results/<env name>``) and prints the tables as Markdown.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
+import sys
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
+import numpy as np
+
 import etsc_envs
-from baselines.cli import episode_setup, limit_torch_threads, parse_assignments
-from baselines.episodes import to_jsonable
+from baselines.cli import episode_setup, limit_torch_threads, parse_assignments, write_json
 from baselines.evaluate import evaluate
+from baselines.statistics import paired_ratio, seeds_ratio
+from etsc_envs.core.files import require_writable_folder
+from etsc_envs.protocol import DEFAULT_SET_SIZE, PROTOCOL_VERSION, SCENARIO_SET_NAMES
 
-RANDOMIZED_SEED = 10_000
-"""First seed of the randomized evaluation scenarios."""
+COST_RATIO_MAX = 1.05
+"""The learned trigger may be this much less accurate than the paper's (cost ratio bound)."""
 
-COST_TOLERANCE = 0.05
-"""The learned trigger may be this much less accurate (relative ``mean_cost``)."""
+TRANSMISSION_RATIO_MAX = 0.70
+"""...with at most this fraction of its transmissions."""
 
-TRANSMISSION_SAVING = 0.30
-"""...and must transmit at least this much less than the paper's trigger."""
+MIN_CLAIM_SEEDS = 3
+"""Training seeds a method's claim stands on, at least."""
 
 PAPER_KEYS = {
     "etsc/AttitudeTracking-v0": ("mean_input_norm",),
@@ -48,8 +64,6 @@ PAPER_KEYS = {
     "etsc/InnerFormation-v0": ("ss_pos_err_m", "ss_pos_est_err_m"),
 }
 """Id → the paper's own metrics shown beside ``mean_cost`` and the transmissions."""
-
-ROW_KEYS = ("mean_cost", "transmissions", "failures")
 
 
 def channel_count(env_id: str, env_args: dict[str, Any]) -> int:
@@ -70,101 +84,171 @@ def equal_rate_period(steps: float, transmissions: float, channels: int) -> int:
     return max(round(channels * steps / transmissions), 1)
 
 
-def _row(result: dict[str, Any], keys: tuple[str, ...]) -> dict[str, Any]:
-    mean = result["mean"]
-    return {key: mean.get(key) for key in (*ROW_KEYS, *keys)}
+def _column(result: dict[str, Any], key: str) -> np.ndarray:
+    return np.array([record[key] for record in result["episodes"]], dtype=float)
 
 
-def meets_goal(learned: dict[str, Any], paper: dict[str, Any]) -> dict[str, Any]:
-    """The goal's two ratios (learned over paper; ``None`` where the paper's value is 0) and
-    whether the goal holds: ``mean_cost`` at most ``1 + COST_TOLERANCE`` times the paper's (so
-    exactly 0 where the paper's is 0), at most ``1 - TRANSMISSION_SAVING`` times its
-    transmissions, and no failed episode."""
-    paper_cost, paper_sent = paper["mean_cost"], paper["transmissions"]
-    met = (
-        learned["mean_cost"] <= paper_cost * (1.0 + COST_TOLERANCE)
-        and learned["transmissions"] <= paper_sent * (1.0 - TRANSMISSION_SAVING)
-        and not learned["failures"]
+def _failures(result: dict[str, Any]) -> int:
+    return sum(record["failure"] is not None for record in result["episodes"])
+
+
+def verdict(
+    cost: dict[str, Any],
+    failures: int,
+    reference_failures: int,
+    cost_max: float,
+    transmissions: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """Whether the intervals support the goal: the upper bounds of the cost ratio (and of the
+    transmission ratio, when given) within their limits and no more failures than the
+    reference. ``reasons`` names every part that fails."""
+    reasons = []
+    cost_high = cost["iqm_ci95"][1] if cost["iqm_ci95"] else None
+    if cost_high is None or cost_high > cost_max:
+        reasons.append(f"cost ratio upper bound {_number(cost_high)} > {cost_max}")
+    if transmissions is not None:
+        sent_high = transmissions["iqm_ci95"][1] if transmissions["iqm_ci95"] else None
+        if sent_high is None or sent_high > TRANSMISSION_RATIO_MAX:
+            reasons.append(
+                f"transmission ratio upper bound {_number(sent_high)} > {TRANSMISSION_RATIO_MAX}"
+            )
+    if failures > reference_failures:
+        reasons.append(f"{failures} failures > {reference_failures}")
+    return {"met": not reasons, "reasons": reasons}
+
+
+def _compare_set(
+    env_id: str,
+    models: list[str],
+    env_args: dict[str, Any],
+    scenarios: str,
+    set_size: int,
+    progress: bool,
+) -> dict[str, Any]:
+    """One scenario set: the paper trigger, every model and its equal-rate clock."""
+
+    def run(spec: str, policy_args: dict[str, Any] | None = None) -> dict[str, Any]:
+        if progress:
+            print(f"[{scenarios} set] {spec} {policy_args or ''}", file=sys.stderr, flush=True)
+        return evaluate(
+            env_id,
+            spec,
+            policy_args=policy_args,
+            env_args=env_args,
+            scenarios=scenarios,
+            set_size=set_size,
+            progress=progress and sys.stderr.isatty(),
+        )
+
+    paper = run("paper")
+    channels = channel_count(env_id, {**env_args, **paper["env_args"]})
+    learned_rows = []
+    for model in models:
+        learned = run(f"sb3:{model}")
+        every = equal_rate_period(
+            learned["mean"]["steps"], learned["mean"]["transmissions"], channels
+        )
+        periodic = run("periodic", {"every": every})
+        vs_paper = {
+            key: paired_ratio(_column(learned, key), _column(paper, key))
+            for key in ("mean_cost", "transmissions")
+        }
+        vs_periodic = paired_ratio(_column(learned, "mean_cost"), _column(periodic, "mean_cost"))
+        learned_rows.append(
+            {
+                "model": model,
+                "learned": learned,
+                "periodic_every": every,
+                "periodic": periodic,
+                "vs_paper": vs_paper,
+                "vs_periodic": {"mean_cost": vs_periodic},
+                "goal": verdict(
+                    vs_paper["mean_cost"],
+                    _failures(learned),
+                    _failures(paper),
+                    COST_RATIO_MAX,
+                    vs_paper["transmissions"],
+                ),
+                "beats_periodic": verdict(
+                    vs_periodic, _failures(learned), _failures(periodic), 1.0
+                ),
+            }
+        )
+    compared: dict[str, Any] = {
+        "scenarios": paper["scenarios"],
+        "paper": paper,
+        "models": learned_rows,
+        "method": _method(learned_rows, paper),
+    }
+    return compared
+
+
+def _method(rows: list[dict[str, Any]], paper: dict[str, Any]) -> dict[str, Any]:
+    """The method's verdicts over its training seeds (rliable IQM, stratified bootstrap)."""
+    seeds = len(rows)
+    if seeds < MIN_CLAIM_SEEDS:
+        return {
+            "seeds": seeds,
+            "claim": False,
+            "note": f"{seeds} training seed(s): a claim needs at least {MIN_CLAIM_SEEDS}",
+        }
+    ratios = {
+        key: seeds_ratio(
+            np.vstack([_column(row["learned"], key) for row in rows]), _column(paper, key)
+        )
+        for key in ("mean_cost", "transmissions")
+    }
+    periodic = seeds_ratio(
+        np.vstack([_column(row["learned"], "mean_cost") for row in rows]),
+        np.vstack([_column(row["periodic"], "mean_cost") for row in rows]),
     )
+    worst = max(_failures(row["learned"]) for row in rows)
+    worst_clock = min(_failures(row["periodic"]) for row in rows)
     return {
-        "cost_ratio": learned["mean_cost"] / paper_cost if paper_cost else None,
-        "transmission_ratio": learned["transmissions"] / paper_sent if paper_sent else None,
-        "met": bool(met),
+        "seeds": seeds,
+        "claim": True,
+        "vs_paper": ratios,
+        "vs_periodic": {"mean_cost": periodic},
+        "goal": verdict(
+            ratios["mean_cost"], worst, _failures(paper), COST_RATIO_MAX, ratios["transmissions"]
+        ),
+        "beats_periodic": verdict(periodic, worst, worst_clock, 1.0),
     }
 
 
 def compare(
-    env_id: str, model: str, env_args: dict[str, Any], randomized_episodes: int
+    env_id: str,
+    models: list[str],
+    env_args: dict[str, Any] | None = None,
+    scenario_sets: tuple[str, ...] = ("paper", "test"),
+    set_size: int = DEFAULT_SET_SIZE,
+    progress: bool = False,
 ) -> dict[str, Any]:
     """The comparison of the module docstring, as a JSON-ready mapping."""
-    keys = PAPER_KEYS.get(env_id, ())
-    paper_scenario = {**env_args, "randomize": False}
-    learned_spec = f"sb3:{model}"
-    paper = evaluate(env_id, "paper", env_args=paper_scenario)
-    learned = evaluate(env_id, learned_spec, env_args=paper_scenario)
-    every = equal_rate_period(
-        learned["mean"]["steps"],
-        learned["mean"]["transmissions"],
-        channel_count(env_id, paper_scenario),
-    )
-    periodic = evaluate(env_id, "periodic", policy_args={"every": every}, env_args=paper_scenario)
-    result: dict[str, Any] = {
+    if not models:
+        raise ValueError("--model must name at least one SB3 zip")
+    for name in scenario_sets:
+        if name not in SCENARIO_SET_NAMES:
+            raise ValueError(f"--scenarios must be among {SCENARIO_SET_NAMES}, got {name!r}")
+    env_args = dict(env_args or {})
+    return {
         "env": env_id,
-        "model": model,
+        "models": list(models),
         "env_args": env_args,
-        "paper_scenario": {
-            "paper": _row(paper, keys),
-            "learned": _row(learned, keys),
-            f"periodic every {every}": _row(periodic, keys),
+        "protocol_version": PROTOCOL_VERSION,
+        "goal": {
+            "cost_ratio_max": COST_RATIO_MAX,
+            "transmission_ratio_max": TRANSMISSION_RATIO_MAX,
+            "min_claim_seeds": MIN_CLAIM_SEEDS,
+        },
+        "sets": {
+            name: _compare_set(env_id, models, env_args, name, set_size, progress)
+            for name in scenario_sets
         },
     }
-    result["paper_scenario"]["goal"] = meets_goal(
-        result["paper_scenario"]["learned"], result["paper_scenario"]["paper"]
-    )
-    if randomized_episodes > 0:
-        randomized = {**env_args, "randomize": True}
-        runs = {
-            name: evaluate(
-                env_id,
-                spec,
-                env_args=randomized,
-                episodes=randomized_episodes,
-                seed=RANDOMIZED_SEED,
-            )
-            for name, spec in (("paper", "paper"), ("learned", learned_spec))
-        }
-        rows = {name: _row(run, keys) for name, run in runs.items()}
-        rows["goal"] = meets_goal(rows["learned"], rows["paper"])
-        rows["episodes"] = randomized_episodes
-        rows["seeds"] = [RANDOMIZED_SEED, RANDOMIZED_SEED + randomized_episodes - 1]
-        result["randomized"] = rows
-    return to_jsonable(result)
 
 
-def markdown(result: dict[str, Any]) -> str:
-    """The comparison as Markdown tables (one per scenario set)."""
-    lines = []
-    for section in ("paper_scenario", "randomized"):
-        if section not in result:
-            continue
-        rows = {name: row for name, row in result[section].items() if isinstance(row, dict)}
-        rows.pop("goal")
-        columns = list(next(iter(rows.values())))
-        title = (
-            "Paper scenario"
-            if section == "paper_scenario"
-            else f"Randomized scenarios ({result[section]['episodes']} episodes, mean)"
-        )
-        lines += [f"**{title}**", "", "| trigger | " + " | ".join(columns) + " |"]
-        lines.append("|---" * (len(columns) + 1) + "|")
-        for name, row in rows.items():
-            lines.append(f"| {name} | " + " | ".join(_cell(row[c]) for c in columns) + " |")
-        goal = result[section]["goal"]
-        lines += ["", _goal_sentence(goal), ""]
-    return "\n".join(lines)
-
-
-def _cell(value: Any) -> str:
+def _number(value: Any) -> str:
     if value is None:
         return "—"
     if isinstance(value, float):
@@ -172,14 +256,86 @@ def _cell(value: Any) -> str:
     return str(value)
 
 
-def _goal_sentence(goal: dict[str, Any]) -> str:
-    cost, sent = goal["cost_ratio"], goal["transmission_ratio"]
-    verdict = "met" if goal["met"] else "not met"
-    return (
-        f"Learned / paper: mean_cost ×{_cell(cost)}, transmissions ×{_cell(sent)} — goal "
-        f"(≤ ×{1 + COST_TOLERANCE:.2f} cost, ≤ ×{1 - TRANSMISSION_SAVING:.2f} transmissions, "
-        f"no failure) {verdict}."
-    )
+def _with_interval(summary: dict[str, Any], key: str = "mean") -> str:
+    low, high = summary[f"{key}_ci95"]
+    if summary["n"] == 1:
+        return _number(summary[key])
+    return f"{_number(summary[key])} [{_number(low)}, {_number(high)}]"
+
+
+def _ratio_text(ratio: dict[str, Any]) -> str:
+    if ratio["iqm"] is None:
+        return "—"
+    low, high = ratio["iqm_ci95"]
+    if ratio["n"] == 1:
+        return f"×{ratio['iqm']:.3g}"
+    return f"×{ratio['iqm']:.3g} [{low:.3g}, {high:.3g}]"
+
+
+def _policy_row(name: str, result: dict[str, Any], keys: tuple[str, ...]) -> str:
+    aggregates = result["aggregates"]
+    failure = aggregates["failure"]
+    settled = aggregates.get("settled")
+    mean = result["mean"]
+    cells = [
+        name,
+        _with_interval(aggregates["mean_cost"]),
+        _with_interval(aggregates["transmissions"]),
+        f"{failure['count']}/{failure['n']}",
+        f"{settled['count']}/{settled['n']}" if settled else "—",
+        *(_number(mean.get(key)) for key in keys),
+    ]
+    return "| " + " | ".join(cells) + " |"
+
+
+def markdown(result: dict[str, Any]) -> str:
+    """The comparison as Markdown: one table per scenario set, then the verdicts."""
+    keys = PAPER_KEYS.get(result["env"], ())
+    lines = []
+    for name, compared in result["sets"].items():
+        size = compared["scenarios"]["size"]
+        title = "Paper scenario" if name == "paper" else f"{name.title()} set ({size} scenarios)"
+        lines += [
+            f"**{title}** — means with 95 % bootstrap intervals",
+            "",
+            "| trigger | mean_cost | transmissions | failures | settled | "
+            + " | ".join(keys)
+            + " |",
+            "|---" * (5 + len(keys)) + "|",
+            _policy_row("paper", compared["paper"], keys),
+        ]
+        for index, row in enumerate(compared["models"], start=1):
+            lines.append(_policy_row(f"learned #{index}", row["learned"], keys))
+            lines.append(
+                _policy_row(f"periodic every {row['periodic_every']}", row["periodic"], keys)
+            )
+        lines.append("")
+        for index, row in enumerate(compared["models"], start=1):
+            lines.append(
+                f"- learned #{index} (`{row['model']}`): cost ×paper "
+                f"{_ratio_text(row['vs_paper']['mean_cost'])}, transmissions ×paper "
+                f"{_ratio_text(row['vs_paper']['transmissions'])}, cost ×periodic "
+                f"{_ratio_text(row['vs_periodic']['mean_cost'])} (IQM of per-scenario ratios); "
+                f"goal {_verdict_text(row['goal'])}; beats periodic "
+                f"{_verdict_text(row['beats_periodic'])}"
+            )
+        method = compared["method"]
+        if method["claim"]:
+            lines.append(
+                f"- method over {method['seeds']} seeds (rliable IQM, stratified bootstrap): "
+                f"cost ×paper {_ratio_text(method['vs_paper']['mean_cost'])}, transmissions "
+                f"×paper {_ratio_text(method['vs_paper']['transmissions'])}; goal "
+                f"{_verdict_text(method['goal'])}; beats periodic "
+                f"{_verdict_text(method['beats_periodic'])}"
+            )
+        else:
+            lines.append(f"- no claim: {method['note']}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _verdict_text(result: dict[str, Any]) -> str:
+    return "**met**" if result["met"] else "not met (" + "; ".join(result["reasons"]) + ")"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -189,26 +345,38 @@ def main(argv: list[str] | None = None) -> int:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("env_id", help="a Gymnasium or PettingZoo id of etsc-envs")
-    parser.add_argument("--model", required=True, help="the SB3 zip of the learned trigger")
-    parser.add_argument("--randomized-episodes", type=int, default=5, metavar="K")
+    parser.add_argument(
+        "--model",
+        action="append",
+        required=True,
+        help="an SB3 zip of the learned trigger (repeat for several training seeds)",
+    )
+    parser.add_argument(
+        "--scenarios",
+        nargs="+",
+        choices=SCENARIO_SET_NAMES,
+        default=["paper", "test"],
+        help="scenario sets to judge on (default: paper test)",
+    )
+    parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
     parser.add_argument("--out", help="output folder (default results/<env name>)")
     args = parser.parse_args(argv)
     limit_torch_threads()
-    if args.randomized_episodes < 0:
-        parser.error(f"--randomized-episodes must be >= 0, got {args.randomized_episodes}")
+    out_dir = Path(args.out or Path("results") / args.env_id.split("/")[-1])
     try:
+        require_writable_folder(out_dir, "--out")
         result = compare(
             args.env_id,
             args.model,
             parse_assignments(args.env_arg, "--env-arg"),
-            args.randomized_episodes,
+            tuple(dict.fromkeys(args.scenarios)),
+            args.set_size,
+            progress=True,
         )
-    except (ValueError, TypeError) as error:
+    except (ValueError, TypeError, gym.error.Error) as error:
         parser.error(str(error))
-    out_dir = Path(args.out or Path("results") / args.env_id.split("/")[-1])
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "results.json").write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    write_json(result, str(out_dir / "results.json"))
     print(markdown(result))
     print(f"wrote {out_dir / 'results.json'}")
     return 0

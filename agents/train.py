@@ -44,6 +44,9 @@ MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
 SUMMARY_FILE = "train_summary.json"
 EVALUATIONS_FILE = "evaluations.json"
+BEST_MODEL_FILE = "best_model.zip"
+"""The model with the best mean return on the validation scenarios so far (checkpoint
+choice follows the test protocol), its observation statistics beside it."""
 CHECKPOINT_DIR = "checkpoints"
 CHECKPOINT_PREFIX = "model"
 TENSORBOARD_DIR = "tensorboard"
@@ -166,6 +169,8 @@ def _periodic_callbacks(config: TrainConfig, out_dir: Path, num_envs: int) -> li
                 {**config.env_kwargs, **config.evaluation_env_kwargs},
                 config.evaluation_every,
                 out_dir / EVALUATIONS_FILE,
+                config.evaluation_scenarios,
+                out_dir / BEST_MODEL_FILE,
             )
         )
     return callbacks

@@ -47,7 +47,7 @@ def test_every_model_loads_with_its_statistics_and_runs(model: Path) -> None:
 def test_evaluate_reproduces_the_learned_row_of_the_results(model: Path) -> None:
     env_id = env_id_of(model)
     recorded = json.loads((RESULTS / model.stem / "results.json").read_text(encoding="utf-8"))
-    row = recorded["paper_scenario"]["learned"]
-    result = evaluate(env_id, f"sb3:{model}", env_args=recorded["env_args"])
+    row = recorded["sets"]["paper"]["models"][0]["learned"]["mean"]
+    result = evaluate(env_id, f"sb3:{model}", env_args=recorded["env_args"], scenarios="paper")
     assert result["mean"]["transmissions"] == row["transmissions"]
     assert result["mean"]["mean_cost"] == pytest.approx(row["mean_cost"], rel=1e-9)

@@ -9,16 +9,17 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.pareto import PAPER_SWEEPS, main, periodic_sweep
+from agents.pareto import PAPER_SWEEPS, main, non_dominated, periodic_sweep
 from baselines.triggers.attitude_tracking import PAPER_PSI
 
 
-def test_pareto_writes_the_paper_and_periodic_curves(tmp_path: Path) -> None:
+def test_pareto_writes_the_curves_with_intervals_and_the_paper_scenario(tmp_path: Path) -> None:
     out_dir = tmp_path / "pareto"
-    argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.3", "--out", str(out_dir)]
-    assert main(argv) == 0
+    argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.3", "--set-size", "3"]
+    assert main([*argv, "--out", str(out_dir)]) == 0
     result = json.loads((out_dir / "pareto.json").read_text(encoding="utf-8"))
     assert (out_dir / "pareto.png").stat().st_size > 0
+    assert (result["scenarios"], result["set_size"]) == ("test", 3)
     curves = result["curves"]
     assert len(curves["paper"]) == len(PAPER_SWEEPS["etsc/AttitudeTracking-v0"]())
     assert any(point["args"] == {"psi": PAPER_PSI} for point in curves["paper"])
@@ -27,9 +28,25 @@ def test_pareto_writes_the_paper_and_periodic_curves(tmp_path: Path) -> None:
     assert curves["learned"] == []
     steps = 300
     for point in curves["periodic"]:
-        assert point["transmissions"] == -(-steps // point["args"]["every"])  # at k = 0, K, 2K..
-    paper_counts = [point["transmissions"] for point in curves["paper"]]
+        expected = -(-steps // point["args"]["every"])  # at k = 0, K, 2K..
+        assert point["transmissions"]["mean"] == expected
+        assert point["transmissions"]["mean_ci95"] == [expected, expected]
+        assert point["paper_scenario"]["transmissions"] == expected
+    for point in curves["paper"]:
+        low, high = point["mean_cost"]["mean_ci95"]
+        assert low <= point["mean_cost"]["mean"] <= high
+    paper_counts = [point["transmissions"]["mean"] for point in curves["paper"]]
     assert paper_counts == sorted(paper_counts, reverse=True), "a higher Ψ transmits less"
+
+
+def test_the_front_keeps_only_non_dominated_points() -> None:
+    points = [(10, 1.0), (20, 0.5), (15, 2.0), (40, 0.6), (40, 0.4), (5, 3.0)]
+    front = non_dominated(
+        [{"sent": sent, "cost": cost} for sent, cost in points],
+        lambda p: p["cost"],
+        lambda p: p["sent"],
+    )
+    assert [(p["sent"], p["cost"]) for p in front] == [(5, 3.0), (10, 1.0), (20, 0.5), (40, 0.4)]
 
 
 @pytest.mark.parametrize("env_id", sorted(PAPER_SWEEPS))
@@ -44,7 +61,7 @@ def test_every_sweep_is_accepted_by_its_paper_trigger(env_id: str) -> None:
 
 def test_reuse_keeps_the_earlier_curves_and_checks_they_match(tmp_path: Path) -> None:
     first = tmp_path / "first"
-    argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.05"]
+    argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.05", "--set-size", "2"]
     assert main([*argv, "--out", str(first)]) == 0
     earlier = json.loads((first / "pareto.json").read_text(encoding="utf-8"))
     second = tmp_path / "second"
