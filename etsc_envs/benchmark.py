@@ -1,7 +1,8 @@
 """Throughput of every environment, single and vectorised, and the papers' reproduction times.
 
     python -m etsc_envs.benchmark [--steps N] [--repeats R] [--env ID ...]
-                                  [--num-envs N ...] [--reproductions [NNN ...]] [--json PATH|-]
+                                  [--num-envs N ...] [--reproductions [NNN ...]]
+                                  [--protocol [K]] [--json PATH|-]
 
 Every figure is the median of ``R`` timed runs (at least 5 by default) after an untimed warm-up
 run that compiles and fills the caches, with the minimum and maximum beside it. Actions are
@@ -17,10 +18,14 @@ that ends is reset inside the timed loop (its cost is part of the figure).
   record adds ``agent_steps_per_s``.
 * ``--reproductions``: the wall time of ``python -m baselines.reproduce --paper NNN`` as a user
   runs it (a fresh process, the compiled code cached on disk), for the given papers or all.
+* ``--protocol [K]``: the wall time of ``python -m baselines.evaluate ID --policy paper
+  --scenarios test --set-size K`` (default K = 64) for every chosen id, as a user runs it;
+  the test protocol asks for at most 2 minutes per id (``docs/protocol.md``).
 
 The JSON is ``{"machine": ..., "envs": {id: {"single_steps_per_s": {"median", "min", "max",
 "runs"}, "vector_env_steps_per_s": {"1": {...}, "16": {...}, "256": {...}}}}, "reproductions":
-{paper: {"wall_time_s": {...}}}}``.
+{paper: {"wall_time_s": {...}}}, "protocol": {"set_size": K, "ids": {id: {"wall_time_s":
+{...}}}}}``.
 """
 
 from __future__ import annotations
@@ -162,6 +167,37 @@ def benchmark_reproductions(papers: list[str], repeats: int) -> dict[str, Any]:
     return results
 
 
+def time_test_set_evaluation(env_id: str, set_size: int) -> float:
+    """Wall-clock seconds of the paper trigger on ``set_size`` test scenarios of ``env_id``
+    (``python -m baselines.evaluate`` in a fresh process)."""
+    command = [
+        sys.executable,
+        "-m",
+        "baselines.evaluate",
+        env_id,
+        "--policy",
+        "paper",
+        "--scenarios",
+        "test",
+        "--set-size",
+        str(set_size),
+    ]
+    started = time.perf_counter()
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    return time.perf_counter() - started
+
+
+def benchmark_protocol(env_ids: list[str], set_size: int, repeats: int) -> dict[str, Any]:
+    """Median wall time of one policy on the test set of each id, after a warm-up run of one
+    scenario that compiles or loads the machine code."""
+    results = {}
+    for env_id in env_ids:
+        time_test_set_evaluation(env_id, 1)
+        runs = [time_test_set_evaluation(env_id, set_size) for _ in range(repeats)]
+        results[env_id] = {"wall_time_s": summary(runs)}
+    return {"set_size": set_size, "ids": results}
+
+
 def machine() -> dict[str, Any]:
     """What the figures were measured on."""
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
@@ -189,6 +225,13 @@ def print_report(payload: dict[str, Any]) -> None:
             print(f"  agent-steps ({agents} agents)    {cell(record['agent_steps_per_s'])} /s")
         for count, figure in record.get("vector_env_steps_per_s", {}).items():
             print(f"  vector env, {count:>4} envs    {cell(figure)} env-steps/s")
+    protocol = payload.get("protocol")
+    for env_id, record in (protocol or {}).get("ids", {}).items():
+        figure = record["wall_time_s"]
+        print(
+            f"{env_id}: paper trigger on {protocol['set_size']} test scenarios "
+            f"{figure['median']:.1f} s [{figure['min']:.1f}, {figure['max']:.1f}]"
+        )
     for paper, record in payload.get("reproductions", {}).items():
         figure = record["wall_time_s"]
         print(
@@ -224,6 +267,14 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NNN",
         help="also time these papers' reproductions (all if none given)",
     )
+    parser.add_argument(
+        "--protocol",
+        nargs="?",
+        type=int,
+        const=64,
+        metavar="K",
+        help="also time the paper trigger on K test scenarios of every chosen id (default 64)",
+    )
     parser.add_argument("--json", metavar="PATH|-", help="write the results as JSON")
     return parser
 
@@ -236,6 +287,8 @@ def main(argv: list[str] | None = None) -> int:
     num_envs = tuple(args.num_envs or DEFAULT_NUM_ENVS)
     if min(num_envs) < 1:
         parser.error("--num-envs must be >= 1")
+    if args.protocol is not None and args.protocol < 1:
+        parser.error(f"--protocol takes a set size >= 1, got {args.protocol}")
     envs = {}
     for env_id in args.env or [*ENV_IDS, *PETTINGZOO_ENV_IDS]:
         if env_id in PETTINGZOO_ENV_IDS:
@@ -251,6 +304,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.reproductions is not None:
         papers = args.reproductions or list(PAPERS)
         payload["reproductions"] = benchmark_reproductions(papers, args.repeats)
+    if args.protocol is not None:
+        ids = args.env or [*ENV_IDS, *PETTINGZOO_ENV_IDS]
+        payload["protocol"] = benchmark_protocol(ids, args.protocol, args.repeats)
     if args.json == "-":
         json.dump(payload, sys.stdout, indent=2)
         sys.stdout.write("\n")
