@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any, NamedTuple
 
 import gymnasium as gym
@@ -15,6 +14,7 @@ import etsc_envs
 from baselines.episodes import run_episode, run_parallel_episode, to_jsonable
 from baselines.policies import AlwaysPolicy, PeriodicPolicy, load_sb3
 from baselines.triggers import PAPER_TRIGGERS
+from etsc_envs.core.files import atomic_write_text
 
 POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
 
@@ -133,15 +133,20 @@ def _policy_for(
     if spec.startswith("sb3:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")
-        return load_sb3(spec.removeprefix("sb3:"))
+        return load_sb3(
+            spec.removeprefix("sb3:"),
+            observation_space=observation_space,
+            action_space=action_space,
+            env_id=env_id,
+        )
     raise ValueError(f"--policy must be one of {POLICY_CHOICES}, got {spec!r}")
 
 
 def write_json(payload: dict[str, Any], destination: str) -> None:
-    """Write ``payload`` as JSON to a file, or to standard output for ``-``."""
+    """Write ``payload`` as JSON to a file (whole or not at all), or to standard output for
+    ``-``."""
     text = json.dumps(to_jsonable(payload), indent=2)
     if destination == "-":
         sys.stdout.write(text + "\n")
     else:
-        Path(destination).parent.mkdir(parents=True, exist_ok=True)
-        Path(destination).write_text(text + "\n")
+        atomic_write_text(destination, text + "\n")
