@@ -61,6 +61,8 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
+from baselines.cli import require_env_id
+from etsc_envs.core.files import require_writable_folder
 
 ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"PPO": PPO, "A2C": A2C, "DQN": DQN}
 """Algorithm name in a config → Stable-Baselines3 class."""
@@ -194,12 +196,7 @@ def _check_env_id(env_id: Any) -> str:
     module, _, bare_id = env_id.rpartition(":")
     if module:
         importlib.import_module(module)
-    if bare_id not in gym.registry:
-        raise ValueError(
-            f"config key 'env_id': {env_id!r} is not registered; "
-            f"etsc-envs registers {sorted(etsc_envs.ENV_IDS)} and the PettingZoo ids "
-            f"{sorted(etsc_envs.PETTINGZOO_ENV_IDS)}"
-        )
+    require_env_id(bare_id, "config key 'env_id'")
     return env_id
 
 
@@ -257,9 +254,50 @@ def _check_hyperparameters(value: Any, algorithm: str) -> dict[str, Any]:
             f"config key 'hyperparameters': {unknown} are not {algorithm} arguments; "
             f"allowed: {allowed}"
         )
+    defaults = _constructor_defaults(ALGORITHMS[algorithm])
     for name, entry in hyperparameters.items():
         _reject_numeric_string(f"hyperparameters.{name}", entry)
+        _check_hyperparameter(name, entry, defaults.get(name))
     return hyperparameters
+
+
+POSITIVE_COUNT_HYPERPARAMETERS = (
+    "n_steps",
+    "batch_size",
+    "n_epochs",
+    "buffer_size",
+    "target_update_interval",
+    "stats_window_size",
+)
+"""Hyperparameters that count steps, samples or passes: integers >= 1 (0 makes SB3 fail with
+an assertion or loop without collecting anything)."""
+
+
+def _constructor_defaults(algorithm_class: type[BaseAlgorithm]) -> dict[str, Any]:
+    parameters = inspect.signature(algorithm_class.__init__).parameters
+    return {
+        name: parameter.default
+        for name, parameter in parameters.items()
+        if parameter.default is not inspect.Parameter.empty
+    }
+
+
+def _check_hyperparameter(name: str, value: Any, default: Any) -> None:
+    """``ValueError`` when ``value`` cannot be what the algorithm's constructor expects: a count
+    of :data:`POSITIVE_COUNT_HYPERPARAMETERS` below 1, or a value of another kind than the
+    default's (a number for a number, true/false for a flag)."""
+    key = f"hyperparameters.{name}"
+    if name in POSITIVE_COUNT_HYPERPARAMETERS and (
+        isinstance(value, bool) or not isinstance(value, int) or value < 1
+    ):
+        raise ValueError(f"config key {key!r} must be an integer >= 1, got {value!r}")
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ValueError(f"config key {key!r} must be true or false, got {value!r}")
+    elif isinstance(default, int | float) and (
+        isinstance(value, bool) or not isinstance(value, int | float)
+    ):
+        raise ValueError(f"config key {key!r} must be a number, got {value!r}")
 
 
 def _constructor_arguments(algorithm_class: type[BaseAlgorithm]) -> list[str]:
@@ -310,6 +348,7 @@ def _check_seed(value: Any) -> int | None:
 def _check_out_dir(value: Any) -> str:
     if not isinstance(value, str | Path) or not str(value):
         raise ValueError(f"config key 'out_dir' must be a directory path, got {value!r}")
+    require_writable_folder(value, "config key 'out_dir'")
     return str(value)
 
 

@@ -12,6 +12,7 @@ from stable_baselines3.common.callbacks import BaseCallback
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
 from baselines.policies import NormalizedModel
+from etsc_envs.core.files import atomic_write_text
 
 COMPARED_KEYS = ("mean_cost", "transmissions", "transmission_rate", "failure")
 """What an evaluation records of each episode (the two axes of the comparison and failure)."""
@@ -68,7 +69,7 @@ class PaperComparisonCallback(BaseCallback):
         for name, summary in (("", learned), ("paper_", self.paper)):
             self.logger.record(f"eval/{name}mean_cost", summary["mean_cost"])
             self.logger.record(f"eval/{name}transmissions", summary["transmissions"])
-        self.out_path.write_text(json.dumps(self.evaluations, indent=2) + "\n", encoding="utf-8")
+        atomic_write_text(self.out_path, json.dumps(self.evaluations, indent=2) + "\n")
         return True
 
     def _on_training_end(self) -> None:

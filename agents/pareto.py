@@ -35,6 +35,7 @@ from baselines.triggers.asteroid import PAPER_ALPHA
 from baselines.triggers.attitude_tracking import PAPER_PSI
 from baselines.triggers.inner_formation import default_thresholds
 from baselines.triggers.orbit_attitude import PAPER_GAMMA
+from etsc_envs.core.files import atomic_write_text, output_folder_argument
 
 SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
 """Multiples of the paper's threshold swept where the threshold is a free positive number."""
@@ -184,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
     parser.add_argument("--seed", type=int, default=0, help="reset seed of every episode")
-    parser.add_argument("--out", type=Path, help="output folder")
+    parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
     parser.add_argument(
         "--reuse",
         type=Path,
@@ -200,8 +201,7 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as error:
         parser.error(str(error))
     out_dir = args.out or Path("results") / "pareto" / args.env_id.split("/")[-1]
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "pareto.json").write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    atomic_write_text(out_dir / "pareto.json", json.dumps(result, indent=2) + "\n")
     plot(result, out_dir / "pareto.png")
     for name, points in result["curves"].items():
         for point in points:

@@ -29,6 +29,7 @@ import etsc_envs
 from baselines.cli import episode_setup, limit_torch_threads, parse_assignments
 from baselines.episodes import to_jsonable
 from baselines.evaluate import evaluate
+from etsc_envs.core.files import atomic_write_text, output_folder_argument
 
 RANDOMIZED_SEED = 10_000
 """First seed of the randomized evaluation scenarios."""
@@ -192,7 +193,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--model", required=True, help="the SB3 zip of the learned trigger")
     parser.add_argument("--randomized-episodes", type=int, default=5, metavar="K")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
-    parser.add_argument("--out", help="output folder (default results/<env name>)")
+    parser.add_argument(
+        "--out",
+        type=output_folder_argument("--out"),
+        help="output folder (default results/<env name>)",
+    )
     args = parser.parse_args(argv)
     limit_torch_threads()
     if args.randomized_episodes < 0:
@@ -207,8 +212,7 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, TypeError) as error:
         parser.error(str(error))
     out_dir = Path(args.out or Path("results") / args.env_id.split("/")[-1])
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "results.json").write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    atomic_write_text(out_dir / "results.json", json.dumps(result, indent=2) + "\n")
     print(markdown(result))
     print(f"wrote {out_dir / 'results.json'}")
     return 0

@@ -25,6 +25,7 @@ from baselines.cli import (
 )
 from baselines.episodes import mean_record
 from baselines.plotting import plot_episode
+from etsc_envs.core.files import output_file_argument
 
 
 def evaluate(
@@ -89,7 +90,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
     parser.add_argument("--episodes", type=int, default=1)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--json", metavar="PATH|-", help="write the results as JSON")
+    parser.add_argument(
+        "--json",
+        metavar="PATH|-",
+        type=output_file_argument("--json"),
+        help="write the results as JSON",
+    )
     parser.add_argument("--plot", metavar="DIR", help="write one figure per episode")
     args = parser.parse_args(argv)
     limit_torch_threads()
