@@ -62,6 +62,7 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
 from baselines.cli import require_env_id
+from baselines.policies import require_model_fits
 from etsc_envs.core.files import require_writable_folder
 
 ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"PPO": PPO, "A2C": A2C, "DQN": DQN}
@@ -172,7 +173,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         ),
         tensorboard=_check_tensorboard(values["tensorboard"]),
         torch_threads=_check_positive_int("torch_threads", values["torch_threads"]),
-        init_from=_check_init_from(values["init_from"]),
+        init_from=_check_init_from(values["init_from"], env_id, env_kwargs),
         imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
     )
@@ -210,18 +211,26 @@ def _check_algorithm_fits_env(algorithm: str, env_id: str, env_kwargs: dict[str,
     """DQN picks one of finitely many actions: it needs a ``Discrete`` action space."""
     if algorithm != "DQN":
         return
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        env = etsc_envs.make_parallel(env_id, **env_kwargs)
-        action_space = env.action_space(env.possible_agents[0])
-    else:
-        env = gym.make(env_id, **env_kwargs)
-        action_space = env.action_space
-    env.close()
+    _, action_space = policy_spaces(env_id, env_kwargs)
     if not isinstance(action_space, gym.spaces.Discrete):
         raise ValueError(
             f"config key 'algorithm': DQN needs a Discrete action space, and {env_id} acts "
             f"with {action_space}; use PPO or A2C"
         )
+
+
+def policy_spaces(env_id: str, env_kwargs: dict[str, Any]) -> tuple[gym.Space, gym.Space]:
+    """The observation and action spaces the trained policy acts in (one agent's, for a
+    PettingZoo id), from one env built with ``env_kwargs``."""
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env = etsc_envs.make_parallel(env_id, **env_kwargs)
+        agent = env.possible_agents[0]
+        spaces = env.observation_space(agent), env.action_space(agent)
+    else:
+        env = gym.make(env_id, **env_kwargs)
+        spaces = env.observation_space, env.action_space
+    env.close()
+    return spaces
 
 
 def _check_policy(policy: Any, algorithm: str) -> str:
@@ -364,7 +373,8 @@ def _check_non_negative_int(key: str, value: Any) -> int:
     return value
 
 
-def _check_init_from(value: Any) -> str | None:
+def _check_init_from(value: Any, env_id: str, env_kwargs: dict[str, Any]) -> str | None:
+    """``value`` if it is null or a saved model that can act in ``env_id``'s spaces."""
     if value is None:
         return None
     if not isinstance(value, str) or not Path(value).is_file():
@@ -372,6 +382,11 @@ def _check_init_from(value: Any) -> str | None:
             f"config key 'init_from' must be the path of a saved model (.zip) or null, "
             f"got {value!r}"
         )
+    try:
+        spaces = policy_spaces(env_id, env_kwargs)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"config key 'env_kwargs': {' '.join(str(error).split())}") from None
+    require_model_fits(value, *spaces, env_id, "config key 'init_from':")
     return value
 
 

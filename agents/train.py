@@ -54,7 +54,7 @@ from agents.config import TrainConfig, load_config
 from agents.evaluation import PaperComparisonCallback
 from agents.imitation import imitate_paper_trigger
 from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
-from baselines.policies import ENV_ID_ATTRIBUTE, normalization_path, require_model_fits
+from baselines.policies import ENV_ID_ATTRIBUTE, normalization_path
 from etsc_envs.core.files import atomic_write_bytes, atomic_write_text
 
 MODEL_FILE = "model.zip"
@@ -201,10 +201,7 @@ def _build_model(
         exceptions=(AssertionError, TypeError, ValueError),
     )
     setattr(model, ENV_ID_ATTRIBUTE, config.env_id)
-    if config.init_from is not None:
-        require_model_fits(
-            config.init_from, env.observation_space, env.action_space, config.env_id, "init_from"
-        )
+    if config.init_from is not None:  # checked to fit the env by the config
         model.set_parameters(config.init_from, device="cpu")
     return model
 
@@ -373,19 +370,11 @@ def _previous_evaluations(out_dir: Path, checkpoint: Path) -> list[dict[str, Any
 def _periodic_callbacks(
     config: TrainConfig, out_dir: Path, num_envs: int, checkpoint: Path | None
 ) -> list[BaseCallback]:
-    """Checkpoints and evaluations against the paper trigger, as configured (``num_envs``:
+    """Evaluations against the paper trigger and checkpoints, as configured (``num_envs``:
     the training ``VecEnv``'s sub-environments, whose steps the intervals count; a resume from
-    ``checkpoint`` keeps the evaluations recorded up to it)."""
+    ``checkpoint`` keeps the evaluations recorded up to it). At a step that has both, the
+    evaluation is recorded first, so that every checkpoint on disk has its evaluation."""
     callbacks: list[BaseCallback] = []
-    if config.checkpoint_every:
-        callbacks.append(
-            AtomicCheckpointCallback(
-                save_freq=max(config.checkpoint_every // num_envs, 1),
-                save_path=str(out_dir / CHECKPOINT_DIR),
-                name_prefix=CHECKPOINT_PREFIX,
-                save_vecnormalize=config.normalize_observations or config.normalize_rewards,
-            )
-        )
     if config.evaluation_every:
         evaluation = PaperComparisonCallback(
             config.env_id,
@@ -396,6 +385,15 @@ def _periodic_callbacks(
         if checkpoint is not None:
             evaluation.evaluations = _previous_evaluations(out_dir, checkpoint)
         callbacks.append(evaluation)
+    if config.checkpoint_every:
+        callbacks.append(
+            AtomicCheckpointCallback(
+                save_freq=max(config.checkpoint_every // num_envs, 1),
+                save_path=str(out_dir / CHECKPOINT_DIR),
+                name_prefix=CHECKPOINT_PREFIX,
+                save_vecnormalize=config.normalize_observations or config.normalize_rewards,
+            )
+        )
     return callbacks
 
 

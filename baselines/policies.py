@@ -189,12 +189,45 @@ def require_model_fits(
         model_actions, action_space
     ):
         return record
-    trained_on = record.get(ENV_ID_ATTRIBUTE) or "an env id it does not record"
+    trained_on = record.get(ENV_ID_ATTRIBUTE) or _ids_fitting(model_observations, model_actions)
     raise ValueError(
         f"{argument} {path} was trained on {trained_on} (observations "
-        f"{model_observations}, actions {model_actions}) and cannot act in {env_id} "
-        f"(observations {observation_space}, actions {action_space})"
+        f"{describe_space(model_observations)}, actions {describe_space(model_actions)}) and "
+        f"cannot act in {env_id} (observations {describe_space(observation_space)}, actions "
+        f"{describe_space(action_space)})"
     )
+
+
+def describe_space(space: gym.Space) -> str:
+    """``space`` in a few words on one line (a ``Box`` by shape and dtype, not its bounds)."""
+    if isinstance(space, gym.spaces.Box):
+        return f"Box(shape={space.shape}, dtype={space.dtype})"
+    return " ".join(str(space).split())
+
+
+def _ids_fitting(observation_space: gym.Space, action_space: gym.Space) -> str:
+    """For a model that does not record its env id: the etsc-envs ids whose default spaces it
+    fits (found by building each env once; only on the way to an error message)."""
+    import etsc_envs
+
+    fitting = []
+    for env_id in sorted(etsc_envs.ENV_IDS):
+        env = gym.make(env_id)
+        if _same_layout(observation_space, env.observation_space) and _same_layout(
+            action_space, env.action_space
+        ):
+            fitting.append(env_id)
+        env.close()
+    for env_id in sorted(etsc_envs.PETTINGZOO_ENV_IDS):
+        env = etsc_envs.make_parallel(env_id)
+        agent = env.possible_agents[0]
+        if _same_layout(observation_space, env.observation_space(agent)) and _same_layout(
+            action_space, env.action_space(agent)
+        ):
+            fitting.append(env_id)
+    if not fitting:
+        return "an env id it does not record (no etsc-envs id has its spaces)"
+    return f"an env id it does not record (its spaces are those of {' and '.join(fitting)})"
 
 
 NORMALIZATION_SUFFIX = "_vecnormalize.pkl"
