@@ -32,6 +32,7 @@ import sys
 import time
 import zipfile
 from collections import deque
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -169,7 +170,12 @@ def _train(config: TrainConfig, out_dir: Path, checkpoint: Path | None) -> Path:
     return out_dir
 
 
-def _checked(key: str, build: Any, *args: Any, exceptions: tuple[type[BaseException], ...]) -> Any:
+def _checked(
+    key: str,
+    build: Callable[..., Any],
+    *args: Any,
+    exceptions: tuple[type[BaseException], ...],
+) -> Any:
     """``build(*args)``, with the ``exceptions`` it raises turned into one ``ValueError`` line
     naming the config ``key``."""
     try:
