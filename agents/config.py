@@ -65,6 +65,9 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
+from baselines.cli import require_env_id
+from baselines.policies import require_model_fits
+from etsc_envs.core.files import require_writable_folder
 from etsc_envs.protocol import require_training_seeds
 
 ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"PPO": PPO, "A2C": A2C, "DQN": DQN}
@@ -184,7 +187,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         ),
         tensorboard=_check_tensorboard(values["tensorboard"]),
         torch_threads=_check_positive_int("torch_threads", values["torch_threads"]),
-        init_from=_check_init_from(values["init_from"]),
+        init_from=_check_init_from(values["init_from"], env_id, env_kwargs),
         imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
     )
@@ -208,12 +211,7 @@ def _check_env_id(env_id: Any) -> str:
     module, _, bare_id = env_id.rpartition(":")
     if module:
         importlib.import_module(module)
-    if bare_id not in gym.registry:
-        raise ValueError(
-            f"config key 'env_id': {env_id!r} is not registered; "
-            f"etsc-envs registers {sorted(etsc_envs.ENV_IDS)} and the PettingZoo ids "
-            f"{sorted(etsc_envs.PETTINGZOO_ENV_IDS)}"
-        )
+    require_env_id(bare_id, "config key 'env_id'")
     return env_id
 
 
@@ -227,18 +225,26 @@ def _check_algorithm_fits_env(algorithm: str, env_id: str, env_kwargs: dict[str,
     """DQN picks one of finitely many actions: it needs a ``Discrete`` action space."""
     if algorithm != "DQN":
         return
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        env = etsc_envs.make_parallel(env_id, **env_kwargs)
-        action_space = env.action_space(env.possible_agents[0])
-    else:
-        env = gym.make(env_id, **env_kwargs)
-        action_space = env.action_space
-    env.close()
+    _, action_space = policy_spaces(env_id, env_kwargs)
     if not isinstance(action_space, gym.spaces.Discrete):
         raise ValueError(
             f"config key 'algorithm': DQN needs a Discrete action space, and {env_id} acts "
             f"with {action_space}; use PPO or A2C"
         )
+
+
+def policy_spaces(env_id: str, env_kwargs: dict[str, Any]) -> tuple[gym.Space, gym.Space]:
+    """The observation and action spaces the trained policy acts in (one agent's, for a
+    PettingZoo id), from one env built with ``env_kwargs``."""
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env = etsc_envs.make_parallel(env_id, **env_kwargs)
+        agent = env.possible_agents[0]
+        spaces = env.observation_space(agent), env.action_space(agent)
+    else:
+        env = gym.make(env_id, **env_kwargs)
+        spaces = env.observation_space, env.action_space
+    env.close()
+    return spaces
 
 
 def _check_policy(policy: Any, algorithm: str) -> str:
@@ -271,9 +277,50 @@ def _check_hyperparameters(value: Any, algorithm: str) -> dict[str, Any]:
             f"config key 'hyperparameters': {unknown} are not {algorithm} arguments; "
             f"allowed: {allowed}"
         )
+    defaults = _constructor_defaults(ALGORITHMS[algorithm])
     for name, entry in hyperparameters.items():
         _reject_numeric_string(f"hyperparameters.{name}", entry)
+        _check_hyperparameter(name, entry, defaults.get(name))
     return hyperparameters
+
+
+POSITIVE_COUNT_HYPERPARAMETERS = (
+    "n_steps",
+    "batch_size",
+    "n_epochs",
+    "buffer_size",
+    "target_update_interval",
+    "stats_window_size",
+)
+"""Hyperparameters that count steps, samples or passes: integers >= 1 (0 makes SB3 fail with
+an assertion or loop without collecting anything)."""
+
+
+def _constructor_defaults(algorithm_class: type[BaseAlgorithm]) -> dict[str, Any]:
+    parameters = inspect.signature(algorithm_class.__init__).parameters
+    return {
+        name: parameter.default
+        for name, parameter in parameters.items()
+        if parameter.default is not inspect.Parameter.empty
+    }
+
+
+def _check_hyperparameter(name: str, value: Any, default: Any) -> None:
+    """``ValueError`` when ``value`` cannot be what the algorithm's constructor expects: a count
+    of :data:`POSITIVE_COUNT_HYPERPARAMETERS` below 1, or a value of another kind than the
+    default's (a number for a number, true/false for a flag)."""
+    key = f"hyperparameters.{name}"
+    if name in POSITIVE_COUNT_HYPERPARAMETERS and (
+        isinstance(value, bool) or not isinstance(value, int) or value < 1
+    ):
+        raise ValueError(f"config key {key!r} must be an integer >= 1, got {value!r}")
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ValueError(f"config key {key!r} must be true or false, got {value!r}")
+    elif isinstance(default, int | float) and (
+        isinstance(value, bool) or not isinstance(value, int | float)
+    ):
+        raise ValueError(f"config key {key!r} must be a number, got {value!r}")
 
 
 def _constructor_arguments(algorithm_class: type[BaseAlgorithm]) -> list[str]:
@@ -324,6 +371,7 @@ def _check_seed(value: Any) -> int | None:
 def _check_out_dir(value: Any) -> str:
     if not isinstance(value, str | Path) or not str(value):
         raise ValueError(f"config key 'out_dir' must be a directory path, got {value!r}")
+    require_writable_folder(value, "config key 'out_dir'")
     return str(value)
 
 
@@ -339,7 +387,8 @@ def _check_non_negative_int(key: str, value: Any) -> int:
     return value
 
 
-def _check_init_from(value: Any) -> str | None:
+def _check_init_from(value: Any, env_id: str, env_kwargs: dict[str, Any]) -> str | None:
+    """``value`` if it is null or a saved model that can act in ``env_id``'s spaces."""
     if value is None:
         return None
     if not isinstance(value, str) or not Path(value).is_file():
@@ -347,6 +396,11 @@ def _check_init_from(value: Any) -> str | None:
             f"config key 'init_from' must be the path of a saved model (.zip) or null, "
             f"got {value!r}"
         )
+    try:
+        spaces = policy_spaces(env_id, env_kwargs)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"config key 'env_kwargs': {' '.join(str(error).split())}") from None
+    require_model_fits(value, *spaces, env_id, "config key 'init_from':")
     return value
 
 

@@ -110,8 +110,15 @@ class PaperComparisonCallback(BaseCallback):
         if self.best_model_path is not None and learned["return"] > self.best_return:
             self.best_return = learned["return"]
             self._save_best()
-        atomic_write_text(self.out_path, json.dumps(to_jsonable(self.evaluations), indent=2))
+        atomic_write_text(self.out_path, json.dumps(to_jsonable(self.evaluations), indent=2) + "\n")
         return True
+
+    def restore(self, history: list[dict[str, Any]]) -> None:
+        """Continue an interrupted run: keep its evaluations (up to the resumed checkpoint)
+        and its best validation return so far."""
+        self.evaluations = list(history)
+        returns = [entry["learned"].get("return") for entry in history if "learned" in entry]
+        self.best_return = max((r for r in returns if r is not None), default=-np.inf)
 
     def _run(self, policy: Any) -> list[dict[str, Any]]:
         return run_batch(self.env_id, policy, self.scenarios.seeds, self.env_kwargs)

@@ -46,7 +46,7 @@ from baselines.triggers.asteroid import PAPER_ALPHA
 from baselines.triggers.attitude_tracking import PAPER_PSI
 from baselines.triggers.inner_formation import default_thresholds
 from baselines.triggers.orbit_attitude import PAPER_GAMMA
-from etsc_envs.core.files import require_writable_folder
+from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.protocol import DEFAULT_SET_SIZE
 
 SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
@@ -319,7 +319,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenarios", choices=("test", "validation"), default="test")
     parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
-    parser.add_argument("--out", type=Path, help="output folder")
+    parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
     parser.add_argument(
         "--reuse",
         type=Path,

@@ -43,7 +43,7 @@ import etsc_envs
 from baselines.cli import episode_setup, limit_torch_threads, parse_assignments, write_json
 from baselines.evaluate import evaluate
 from baselines.statistics import paired_ratio, seeds_ratio
-from etsc_envs.core.files import require_writable_folder
+from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.protocol import DEFAULT_SET_SIZE, PROTOCOL_VERSION, SCENARIO_SET_NAMES
 
 COST_RATIO_MAX = 1.05
@@ -360,7 +360,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
-    parser.add_argument("--out", help="output folder (default results/<env name>)")
+    parser.add_argument(
+        "--out",
+        type=output_folder_argument("--out"),
+        help="output folder (default results/<env name>)",
+    )
     args = parser.parse_args(argv)
     limit_torch_threads()
     out_dir = Path(args.out or Path("results") / args.env_id.split("/")[-1])

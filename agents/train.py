@@ -9,8 +9,15 @@ Writes to the output directory ``model.zip`` (a plain SB3 save, loadable by
 config after the command-line overrides and defaults), ``train_summary.json`` (wall time,
 timesteps, steps per second and the last episodes' returns and metrics), and as configured
 ``checkpoints/``, ``tensorboard/`` and ``evaluations.json`` (the policy against the paper's
-trigger during training). ``--resume`` continues from the newest checkpoint in
-``checkpoints/`` up to ``total_timesteps``.
+trigger during training). ``--resume`` continues from the newest intact checkpoint in
+``checkpoints/`` up to ``total_timesteps``, keeping the evaluation history up to that
+checkpoint; it refuses checkpoints written under another config (``checkpoints/run.yaml``
+records the config that wrote them; only :data:`RESUMABLE_CHANGES` may differ).
+
+Every output file is written through a temporary file and a rename
+(:mod:`etsc_envs.core.files`), so an interrupted run leaves whole files or none; a run that
+fails before writing anything leaves no ``out_dir`` behind. Interrupted (Ctrl-C), the command
+prints one line saying how to continue and exits with status 130.
 """
 
 from __future__ import annotations
@@ -18,9 +25,14 @@ from __future__ import annotations
 import argparse
 import functools
 import importlib.util
+import io
 import json
+import pickle
+import sys
 import time
+import zipfile
 from collections import deque
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +41,12 @@ import numpy as np
 import torch
 import yaml
 from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
+from stable_baselines3.common.callbacks import (
+    BaseCallback,
+    CallbackList,
+    CheckpointCallback,
+    ProgressBarCallback,
+)
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 
@@ -38,7 +55,8 @@ from agents.config import TrainConfig, load_config
 from agents.evaluation import PaperComparisonCallback
 from agents.imitation import imitate_paper_trigger
 from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
-from baselines.policies import normalization_path
+from baselines.policies import ENV_ID_ATTRIBUTE, normalization_path
+from etsc_envs.core.files import atomic_write_bytes, atomic_write_text
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
@@ -49,7 +67,19 @@ BEST_MODEL_FILE = "best_model.zip"
 choice follows the test protocol), its observation statistics beside it."""
 CHECKPOINT_DIR = "checkpoints"
 CHECKPOINT_PREFIX = "model"
+RUN_FILE = "run.yaml"
+"""In ``checkpoints/``: the config of the run that writes the checkpoints there."""
 TENSORBOARD_DIR = "tensorboard"
+RESUMABLE_CHANGES = (
+    "total_timesteps",
+    "out_dir",
+    "checkpoint_every",
+    "evaluation_every",
+    "tensorboard",
+    "torch_threads",
+)
+"""Config keys a ``--resume`` may change; any other difference from the checkpoints' config
+refuses the resume (the run would continue another experiment under this config's name)."""
 RECENT_EPISODES_KEPT = 5
 """How many of the last finished episodes ``train_summary.json`` reports."""
 
@@ -84,27 +114,32 @@ def _plain(value: Any) -> Any:
 
 
 def train(config: TrainConfig, resume: bool = False) -> Path:
-    """Train the configured model (from the newest checkpoint if ``resume``), write the output
-    files and return the output folder."""
+    """Train the configured model (from the newest intact checkpoint if ``resume``), write the
+    output files and return the output folder. A bad env kwarg, hyperparameter, ``init_from``
+    or checkpoint raises ``ValueError`` before ``out_dir`` is created."""
     torch.set_num_threads(config.torch_threads)
     out_dir = Path(config.out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    checkpoint = latest_checkpoint(out_dir / CHECKPOINT_DIR) if resume else None
+    checkpoint = resume_checkpoint(config) if resume else None
+    if not resume:
+        _refuse_foreign_checkpoints(config)
+    created = not out_dir.exists()
+    try:
+        return _train(config, out_dir, checkpoint)
+    except BaseException:
+        if created:
+            _remove_empty_folders(out_dir)
+        raise
+
+
+def _train(config: TrainConfig, out_dir: Path, checkpoint: Path | None) -> Path:
+    env = _checked(
+        "env_kwargs", make_training_env, config, checkpoint, exceptions=(TypeError, ValueError)
+    )
+    model = _build_model(config, env, checkpoint, out_dir)
     imitation: dict[str, Any] | None = None
-    if resume and checkpoint is None:
-        raise ValueError(f"--resume: no checkpoint in {out_dir / CHECKPOINT_DIR}")
-    env = make_training_env(config, checkpoint)
-    tensorboard_log = str(out_dir / TENSORBOARD_DIR) if config.tensorboard else None
     if checkpoint is None:
-        model = config.algorithm_class(
-            config.policy,
-            env,
-            seed=config.seed,
-            tensorboard_log=tensorboard_log,
-            **config.hyperparameters,
-        )
-        if config.init_from is not None:
-            model.set_parameters(config.init_from, device="cpu")
+        if config.checkpoint_every:
+            _write_config(config, out_dir / CHECKPOINT_DIR / RUN_FILE)
         if config.imitation_steps:
             imitation = imitate_paper_trigger(
                 model,
@@ -113,64 +148,261 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
                 config.imitation_steps,
                 config.imitation_epochs,
             )
-    else:
-        model = config.algorithm_class.load(
-            checkpoint, env=env, device="cpu", tensorboard_log=tensorboard_log
-        )
     metrics_callback = EpisodeMetricsCallback()
     start = time.perf_counter()
-    periodic = _periodic_callbacks(config, out_dir, env.num_envs)
-    model.learn(
-        total_timesteps=max(config.total_timesteps - model.num_timesteps, 0),
-        callback=CallbackList([metrics_callback, *periodic]),
-        progress_bar=_progress_bar_available(),
-        reset_num_timesteps=checkpoint is None,
-    )
+    periodic = _periodic_callbacks(config, out_dir, env.num_envs, checkpoint)
+    progress = [ProgressBarCallback()] if _progress_bar_available() else []
+    try:
+        model.learn(
+            total_timesteps=max(config.total_timesteps - model.num_timesteps, 0),
+            callback=CallbackList([metrics_callback, *periodic, *progress]),
+            reset_num_timesteps=checkpoint is None,
+        )
+    finally:
+        for bar in progress:  # an interrupted learn() skips the bar's own close
+            if hasattr(bar, "pbar"):
+                bar.pbar.close()
     wall_time_s = time.perf_counter() - start
-    model.save(out_dir / MODEL_FILE)
-    normalization = model.get_vec_normalize_env()
-    if normalization is not None:
-        normalization.save(normalization_path(out_dir / MODEL_FILE))
+    save_model(model, out_dir / MODEL_FILE)
     env.close()
     _write_config(config, out_dir / CONFIG_FILE)
     summary = _summary(config, model, metrics_callback, wall_time_s)
     summary["resumed_from"] = None if checkpoint is None else str(checkpoint)
     summary["imitation"] = imitation
-    (out_dir / SUMMARY_FILE).write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    atomic_write_text(out_dir / SUMMARY_FILE, json.dumps(summary, indent=2) + "\n")
     return out_dir
+
+
+def _checked(
+    key: str,
+    build: Callable[..., Any],
+    *args: Any,
+    exceptions: tuple[type[BaseException], ...],
+) -> Any:
+    """``build(*args)``, with the ``exceptions`` it raises turned into one ``ValueError`` line
+    naming the config ``key``."""
+    try:
+        return build(*args)
+    except exceptions as error:
+        message = " ".join(str(error).split())
+        raise ValueError(f"config key {key!r}: {message}") from None
+
+
+def _build_model(
+    config: TrainConfig, env: VecEnv, checkpoint: Path | None, out_dir: Path
+) -> BaseAlgorithm:
+    """A new model (with ``init_from``'s weights if configured), or the resumed checkpoint."""
+    tensorboard_log = str(out_dir / TENSORBOARD_DIR) if config.tensorboard else None
+    if checkpoint is not None:
+        return config.algorithm_class.load(
+            checkpoint, env=env, device="cpu", tensorboard_log=tensorboard_log
+        )
+    model = _checked(
+        "hyperparameters",
+        functools.partial(
+            config.algorithm_class,
+            config.policy,
+            env,
+            seed=config.seed,
+            tensorboard_log=tensorboard_log,
+            **config.hyperparameters,
+        ),
+        exceptions=(AssertionError, TypeError, ValueError),
+    )
+    setattr(model, ENV_ID_ATTRIBUTE, config.env_id)
+    if config.init_from is not None:  # checked to fit the env by the config
+        model.set_parameters(config.init_from, device="cpu")
+    return model
+
+
+def save_model(model: BaseAlgorithm, path: Path) -> None:
+    """Save ``model`` at ``path`` and its normalisation statistics beside it (if any), each
+    through a temporary file and a rename, the statistics first: a model file on disk always
+    has its statistics."""
+    normalization = model.get_vec_normalize_env()
+    if normalization is not None:
+        atomic_write_bytes(normalization_path(path), pickle.dumps(normalization))
+    buffer = io.BytesIO()
+    model.save(buffer)
+    atomic_write_bytes(path, buffer.getvalue())
+
+
+class AtomicCheckpointCallback(CheckpointCallback):
+    """SB3's checkpoints (``model_<N>_steps.zip`` with ``model_vecnormalize_<N>_steps.pkl``),
+    written through temporary files, statistics first (:func:`save_model`)."""
+
+    def _on_step(self) -> bool:
+        if self.n_calls % self.save_freq == 0:
+            statistics = self.model.get_vec_normalize_env() if self.save_vecnormalize else None
+            if statistics is not None:
+                atomic_write_bytes(
+                    self._checkpoint_path("vecnormalize_", extension="pkl"),
+                    pickle.dumps(statistics),
+                )
+            buffer = io.BytesIO()
+            self.model.save(buffer)
+            atomic_write_bytes(self._checkpoint_path(extension="zip"), buffer.getvalue())
+        return True
 
 
 def latest_checkpoint(folder: Path) -> Path | None:
     """The checkpoint with the most timesteps in ``folder`` (``model_<N>_steps.zip``)."""
-    checkpoints = sorted(
-        folder.glob(f"{CHECKPOINT_PREFIX}_*_steps.zip"),
-        key=lambda path: int(path.stem.split("_")[-2]),
+    checkpoints = checkpoints_newest_first(folder)
+    return checkpoints[0] if checkpoints else None
+
+
+def checkpoints_newest_first(folder: Path) -> list[Path]:
+    """The checkpoints in ``folder`` (``model_<N>_steps.zip``), most timesteps first."""
+    return sorted(
+        (path for path in folder.glob(f"{CHECKPOINT_PREFIX}_*_steps.zip") if _steps(path)),
+        key=_steps,
+        reverse=True,
     )
-    return checkpoints[-1] if checkpoints else None
 
 
-def _periodic_callbacks(config: TrainConfig, out_dir: Path, num_envs: int) -> list[BaseCallback]:
-    """Checkpoints and evaluations against the paper trigger, as configured (``num_envs``:
-    the training ``VecEnv``'s sub-environments, whose steps the intervals count)."""
+def _steps(checkpoint: Path) -> int | None:
+    """The ``N`` of ``model_<N>_steps.zip``, or ``None`` for another name."""
+    middle = checkpoint.stem.removeprefix(f"{CHECKPOINT_PREFIX}_").removesuffix("_steps")
+    return int(middle) if middle.isdigit() else None
+
+
+def resume_checkpoint(config: TrainConfig) -> Path:
+    """The newest intact checkpoint of ``config``'s run, or ``ValueError``: no checkpoint, a
+    checkpoint folder written under another config (or of unknown config), or none intact.
+    A torn checkpoint (unreadable zip, missing or unreadable statistics) is skipped with a
+    note on standard error."""
+    folder = Path(config.out_dir) / CHECKPOINT_DIR
+    checkpoints = checkpoints_newest_first(folder)
+    if not checkpoints:
+        raise ValueError(f"--resume: no checkpoint in {folder}")
+    _require_same_run(config, folder)
+    normalized = config.normalize_observations or config.normalize_rewards
+    for checkpoint in checkpoints:
+        problem = _checkpoint_problem(checkpoint, normalized)
+        if problem is None:
+            return checkpoint
+        print(f"--resume: skipping {checkpoint.name}: {problem}", file=sys.stderr)
+    raise ValueError(f"--resume: no intact checkpoint in {folder} (all {len(checkpoints)} torn)")
+
+
+def _require_same_run(config: TrainConfig, folder: Path) -> None:
+    """``ValueError`` unless ``folder/run.yaml`` records ``config`` up to
+    :data:`RESUMABLE_CHANGES`."""
+    record = folder / RUN_FILE
+    try:
+        recorded = yaml.safe_load(record.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError):
+        recorded = None
+    if not isinstance(recorded, dict):
+        raise ValueError(
+            f"--resume: {record} is missing or unreadable, so the checkpoints in {folder} "
+            "cannot be matched to this config; train afresh into another out_dir"
+        )
+    current = config.as_dict()
+    differing = sorted(
+        key
+        for key in set(current) | set(recorded)
+        if key not in RESUMABLE_CHANGES and current.get(key) != recorded.get(key)
+    )
+    if differing:
+        changes = ", ".join(
+            f"{key}: {recorded.get(key)!r} -> {current.get(key)!r}" for key in differing
+        )
+        raise ValueError(
+            f"--resume: the checkpoints in {folder} belong to another config ({changes}); "
+            "resume with the config that wrote them or train into another out_dir"
+        )
+
+
+def _refuse_foreign_checkpoints(config: TrainConfig) -> None:
+    """A fresh run must not write its checkpoints among an earlier run's (a later resume would
+    take the highest step count, whichever run wrote it)."""
+    folder = Path(config.out_dir) / CHECKPOINT_DIR
+    newest = latest_checkpoint(folder)
+    if config.checkpoint_every and newest is not None:
+        raise ValueError(
+            f"out_dir already holds checkpoints of an earlier run ({newest}); continue it with "
+            "--resume, or train into another out_dir"
+        )
+
+
+def _checkpoint_problem(checkpoint: Path, normalized: bool) -> str | None:
+    """Why ``checkpoint`` cannot be resumed from (``None`` if it can)."""
+    try:
+        with zipfile.ZipFile(checkpoint) as archive:
+            damaged = archive.testzip()
+            names = set(archive.namelist())
+    except (OSError, zipfile.BadZipFile) as error:
+        return f"unreadable zip ({error})"
+    if damaged is not None or not {"data", "policy.pth"} <= names:
+        return "damaged or incomplete zip"
+    if not normalized:
+        return None
+    statistics = _checkpoint_statistics(checkpoint)
+    try:
+        pickle.loads(statistics.read_bytes())
+    except FileNotFoundError:
+        return f"its statistics {statistics.name} are missing"
+    except Exception as error:
+        return f"its statistics {statistics.name} are unreadable ({type(error).__name__})"
+    return None
+
+
+def _remove_empty_folders(folder: Path) -> None:
+    """Remove ``folder`` and its subfolders if no file is left in them."""
+    if not folder.is_dir():
+        return
+    for child in folder.iterdir():
+        _remove_empty_folders(child)
+    if not any(folder.iterdir()):
+        folder.rmdir()
+
+
+def _previous_evaluations(out_dir: Path, checkpoint: Path) -> list[dict[str, Any]]:
+    """The evaluations an earlier run recorded up to ``checkpoint``'s timesteps (those after it
+    are of training the resume repeats)."""
+    try:
+        history = json.loads((out_dir / EVALUATIONS_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return []
+    if not isinstance(history, list):
+        return []
+    steps = _steps(checkpoint)
+    return [
+        entry
+        for entry in history
+        if isinstance(entry, dict) and isinstance(entry.get("timesteps"), int)
+        if entry["timesteps"] <= steps
+    ]
+
+
+def _periodic_callbacks(
+    config: TrainConfig, out_dir: Path, num_envs: int, checkpoint: Path | None
+) -> list[BaseCallback]:
+    """Evaluations against the paper trigger and checkpoints, as configured (``num_envs``:
+    the training ``VecEnv``'s sub-environments, whose steps the intervals count; a resume from
+    ``checkpoint`` keeps the evaluations recorded up to it). At a step that has both, the
+    evaluation is recorded first, so that every checkpoint on disk has its evaluation."""
     callbacks: list[BaseCallback] = []
+    if config.evaluation_every:
+        evaluation = PaperComparisonCallback(
+            config.env_id,
+            {**config.env_kwargs, **config.evaluation_env_kwargs},
+            config.evaluation_every,
+            out_dir / EVALUATIONS_FILE,
+            config.evaluation_scenarios,
+            out_dir / BEST_MODEL_FILE,
+        )
+        if checkpoint is not None:
+            evaluation.restore(_previous_evaluations(out_dir, checkpoint))
+        callbacks.append(evaluation)
     if config.checkpoint_every:
         callbacks.append(
-            CheckpointCallback(
+            AtomicCheckpointCallback(
                 save_freq=max(config.checkpoint_every // num_envs, 1),
                 save_path=str(out_dir / CHECKPOINT_DIR),
                 name_prefix=CHECKPOINT_PREFIX,
                 save_vecnormalize=config.normalize_observations or config.normalize_rewards,
-            )
-        )
-    if config.evaluation_every:
-        callbacks.append(
-            PaperComparisonCallback(
-                config.env_id,
-                {**config.env_kwargs, **config.evaluation_env_kwargs},
-                config.evaluation_every,
-                out_dir / EVALUATIONS_FILE,
-                config.evaluation_scenarios,
-                out_dir / BEST_MODEL_FILE,
             )
         )
     return callbacks
@@ -245,7 +477,7 @@ def _progress_bar_available() -> bool:
 
 
 def _write_config(config: TrainConfig, path: Path) -> None:
-    path.write_text(yaml.safe_dump(config.as_dict(), sort_keys=False), encoding="utf-8")
+    atomic_write_text(path, yaml.safe_dump(config.as_dict(), sort_keys=False))
 
 
 def _summary(
@@ -300,6 +532,13 @@ def main(argv: list[str] | None = None) -> int:
         out_dir = train(config, resume=args.resume)
     except ValueError as error:
         parser.error(str(error))
+    except KeyboardInterrupt:
+        print(
+            f"\ninterrupted; continue from the last checkpoint with: python -m agents.train "
+            f"--config {args.config} --out {config.out_dir} --resume",
+            file=sys.stderr,
+        )
+        return 130
     for path in sorted(out_dir.iterdir()):
         print(f"wrote {path}")
     return 0

@@ -98,9 +98,23 @@ class EpisodeSetup(NamedTuple):
     """:func:`~baselines.episodes.run_episode` or its PettingZoo form."""
 
 
+def require_env_id(env_id: Any, argument: str = "env_id") -> str:
+    """``env_id`` if it is registered with Gymnasium or a PettingZoo id of etsc-envs, else
+    ``ValueError`` naming ``argument`` and listing the ids etsc-envs provides."""
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS or (
+        isinstance(env_id, str) and env_id in gym.registry
+    ):
+        return env_id
+    raise ValueError(
+        f"{argument}: {env_id!r} is not registered; etsc-envs registers "
+        f"{sorted(etsc_envs.ENV_IDS)} and the PettingZoo ids {sorted(etsc_envs.PETTINGZOO_ENV_IDS)}"
+    )
+
+
 def episode_setup(env_id: str, env_args: dict[str, Any]) -> EpisodeSetup:
     """``env_id`` (a Gymnasium or a PettingZoo id) built with ``env_args``, as an
-    :class:`EpisodeSetup`."""
+    :class:`EpisodeSetup` (``ValueError`` for an unknown id)."""
+    require_env_id(env_id)
     if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env = etsc_envs.make_parallel(env_id, **env_args)
         return EpisodeSetup(
@@ -133,7 +147,12 @@ def _policy_for(
     if spec.startswith("sb3:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")
-        return load_sb3(spec.removeprefix("sb3:"))
+        return load_sb3(
+            spec.removeprefix("sb3:"),
+            observation_space=observation_space,
+            action_space=action_space,
+            env_id=env_id,
+        )
     raise ValueError(f"--policy must be one of {POLICY_CHOICES}, got {spec!r}")
 
 

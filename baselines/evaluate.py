@@ -31,7 +31,7 @@ from baselines.cli import (
 from baselines.episodes import mean_record
 from baselines.plotting import plot_episode
 from baselines.statistics import aggregate_lines, aggregate_records
-from etsc_envs.core.files import require_writable_file
+from etsc_envs.core.files import output_file_argument
 from etsc_envs.protocol import DEFAULT_SET_SIZE, SCENARIO_SET_NAMES, scenario_set
 
 
@@ -141,13 +141,16 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--episodes", type=int, default=1)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--json", metavar="PATH|-", help="write the results as JSON")
+    parser.add_argument(
+        "--json",
+        metavar="PATH|-",
+        type=output_file_argument("--json"),
+        help="write the results as JSON",
+    )
     parser.add_argument("--plot", metavar="DIR", help="write one figure per episode")
     args = parser.parse_args(argv)
     limit_torch_threads()
     try:
-        if args.json not in (None, "-"):
-            require_writable_file(args.json, "--json")
         result = evaluate(
             args.env_id,
             args.policy,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import matplotlib
@@ -11,14 +12,18 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from baselines.episodes import EpisodeTrace
+from etsc_envs.core.files import atomic_write_bytes
 
 
 def save(figure: plt.Figure, path: Path) -> Path:
-    """Write ``figure`` to ``path`` (creating folders) and close it."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=120, bbox_inches="tight")
+    """Write ``figure`` to ``path`` (creating folders; whole or not at all, in the format of
+    the file's suffix) and close it."""
+    buffer = io.BytesIO()
+    figure.savefig(
+        buffer, format=Path(path).suffix.lstrip(".") or None, dpi=120, bbox_inches="tight"
+    )
     plt.close(figure)
-    return path
+    return atomic_write_bytes(path, buffer.getvalue())
 
 
 def plot_interevent(axis: plt.Axes, transmission_times_s: list[float], label: str = "") -> None:

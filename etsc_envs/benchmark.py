@@ -39,7 +39,6 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -47,6 +46,7 @@ import numba
 import numpy as np
 
 from etsc_envs import ENV_IDS, PETTINGZOO_ENV_IDS, VECTOR_ENTRY_POINTS, make_parallel
+from etsc_envs.core.files import atomic_write_text, output_file_argument
 
 DEFAULT_NUM_ENVS = (1, 16, 256)
 VECTOR_CALLS_MIN = 200
@@ -275,7 +275,12 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="K",
         help="also time the paper trigger on K test scenarios of every chosen id (default 64)",
     )
-    parser.add_argument("--json", metavar="PATH|-", help="write the results as JSON")
+    parser.add_argument(
+        "--json",
+        metavar="PATH|-",
+        type=output_file_argument("--json"),
+        help="write the results as JSON",
+    )
     return parser
 
 
@@ -312,7 +317,7 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.write("\n")
         return 0
     if args.json:
-        Path(args.json).write_text(json.dumps(payload, indent=2) + "\n")
+        atomic_write_text(args.json, json.dumps(payload, indent=2) + "\n")
     print_report(payload)
     return 0
 

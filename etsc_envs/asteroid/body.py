@@ -17,6 +17,7 @@ import numpy as np
 from etsc_envs.asteroid.gravity import GRAVITATIONAL_CONSTANT, Polyhedron, make_polyhedron
 from etsc_envs.asteroid.gravity_grid import PACKAGE_DATA, GridField, load_or_build
 from etsc_envs.asteroid.shape import ShapeModel, read_shape
+from etsc_envs.core.validation import require_positive
 
 PACKAGED_SHAPE = PACKAGE_DATA / "itokawa.obj"
 CENTRING_TOLERANCE_M = 1e-3
@@ -46,6 +47,13 @@ def resolve_shape(
 ) -> ShapeModel:
     """The shape to use: the packaged Itokawa for ``None``, a file path, or a model, centred on
     its centre of mass when it is off the origin."""
+    if length_unit_m is not None:
+        require_positive("shape_length_unit_m", length_unit_m)
+        if not isinstance(shape, str | Path):
+            raise ValueError(
+                "shape_length_unit_m applies only to a shape file (shape=PATH), "
+                f"got shape={shape!r}"
+            )
     if shape is None:
         model = packaged_itokawa()
     elif isinstance(shape, ShapeModel):

@@ -170,9 +170,8 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
         **overrides: Any,
     ) -> None:
         self.params = p = apply_overrides(
-            params if params is not None else AsteroidParams(), overrides, "AsteroidOrbitKeepingEnv"
+            AsteroidParams, params, overrides, "AsteroidOrbitKeepingEnv"
         )
-        self.randomize = bool(randomize)
         if isinstance(decision_interval, bool) or int(decision_interval) != decision_interval:
             raise ValueError(
                 f"decision_interval must be an integer >= 1, got {decision_interval!r}"
@@ -234,6 +233,7 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
+            randomize=randomize,
             failure_cost=worst_outside**2 * decision_period,
         )
         self._point_at_sun(p.sun_azimuth_deg)

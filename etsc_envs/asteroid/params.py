@@ -7,7 +7,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from etsc_envs.core.validation import require_non_negative, require_positive, require_vector
+from etsc_envs.core.validation import (
+    require_field_types,
+    require_non_negative,
+    require_positive,
+    require_vector,
+)
 
 ASTRONOMICAL_UNIT_M = 1.495978707e11
 
@@ -120,6 +125,7 @@ class AsteroidParams:
         )
 
     def __post_init__(self) -> None:
+        require_field_types(self)
         require_vector("inertia_kg_m2", self.inertia_kg_m2, 3, positive=True)
         require_vector("initial_attitude_error_deg", self.initial_attitude_error_deg, 3)
         require_vector("initial_rate_rad_s", self.initial_rate_rad_s, 3)

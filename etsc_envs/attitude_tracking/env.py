@@ -97,11 +97,8 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
         **overrides: Any,
     ) -> None:
         self.params = apply_overrides(
-            params if params is not None else AttitudeTrackingParams(),
-            overrides,
-            "AttitudeTrackingEnv",
+            AttitudeTrackingParams, params, overrides, "AttitudeTrackingEnv"
         )
-        self.randomize = bool(randomize)
         p = self.params
         self.gains = LoopGains(
             attitude_gain=np.array(p.attitude_gain, dtype=float),
@@ -146,6 +143,7 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
+            randomize=randomize,
             failure_cost=p.max_rate_rad_s,
         )
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from etsc_envs.core.validation import (
     require_choice,
+    require_field_types,
     require_positive,
     require_spd_matrix,
     require_unit_quaternion,
@@ -75,6 +76,7 @@ class AttitudeTrackingParams:
     """Failure bound on ‖ω‖ and ‖ω_e‖: beyond it the episode terminates as diverged."""
 
     def __post_init__(self) -> None:
+        require_field_types(self)
         require_spd_matrix("nominal_inertia", self.nominal_inertia)
         for name in (
             "inertia_variation_amplitude",

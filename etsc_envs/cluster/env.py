@@ -145,8 +145,7 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
         randomize: bool = False,
         **overrides: Any,
     ) -> None:
-        self.params = replace_params(params or ClusterContainmentParams(), overrides)
-        self.randomize = bool(randomize)
+        self.params = replace_params(params, overrides)
         p = self.params
         n = p.n_followers
         self.agent_names = tuple(f"follower_{i}" for i in range(n))
@@ -169,6 +168,7 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
+            randomize=randomize,
             failure_cost=n * error_bound,
         )
 

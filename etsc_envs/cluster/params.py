@@ -22,6 +22,8 @@ from etsc_envs.cluster.topology import adjacency_from_edges, validate_adjacency
 from etsc_envs.core.validation import (
     apply_overrides,
     require_choice,
+    require_field_types,
+    require_float_array,
     require_non_negative,
     require_positive,
     require_spd_matrix,
@@ -141,10 +143,6 @@ def _scenario_defaults(scenario: str) -> dict[str, object]:
     }
 
 
-def _as_array(value: object) -> np.ndarray:
-    return np.asarray(value, dtype=float)
-
-
 @dataclass(frozen=True)
 class ClusterContainmentParams:
     """Model, controller and scenario of paper 001; defaults are the paper's values.
@@ -203,29 +201,37 @@ class ClusterContainmentParams:
     """Failure bound on ‖ω_i‖ (the paper's rates stay below 0.03 rad/s)."""
 
     def __post_init__(self) -> None:
+        require_field_types(self)
         require_choice("scenario", self.scenario, SCENARIOS)
         defaults = _scenario_defaults(self.scenario)
         for name, value in defaults.items():
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
-        leaders = _as_array(self.leader_attitudes)
+        leaders = require_float_array("leader_attitudes", self.leader_attitudes)
         if leaders.ndim != 2 or leaders.shape[1] != 3 or not np.all(np.isfinite(leaders)):
             raise ValueError(f"leader_attitudes must be an M×3 array, got shape {leaders.shape}")
-        initial = _as_array(self.initial_attitudes)
+        outside = np.flatnonzero(np.linalg.norm(leaders, axis=1) > 1.0)
+        if outside.size:
+            raise ValueError(
+                f"leader_attitudes must be MRPs in the unit ball (|σ| <= 1, rotations up to "
+                f"180°); leader(s) {outside.tolist()} have |σ| = "
+                f"{np.linalg.norm(leaders[outside], axis=1).round(6).tolist()}"
+            )
+        initial = require_float_array("initial_attitudes", self.initial_attitudes)
         if initial.ndim != 2 or initial.shape[1] != 3 or len(initial) < 1:
             raise ValueError(f"initial_attitudes must be an N×3 array, got shape {initial.shape}")
         n, m = len(initial), len(leaders)
         object.__setattr__(self, "leader_attitudes", leaders)
         object.__setattr__(self, "adjacency", validate_adjacency("adjacency", self.adjacency, n, m))
         for name in ("initial_attitudes", "initial_rates", "constant_disturbances"):
-            array = _as_array(getattr(self, name))
+            array = require_float_array(name, getattr(self, name))
             if array.shape != (n, 3) or not np.all(np.isfinite(array)):
                 raise ValueError(f"{name} must be a finite {n}×3 array, got shape {array.shape}")
             object.__setattr__(self, name, array)
         for name in ("nominal_inertias", "inertia_uncertainty"):
             if getattr(self, name) is None:
                 continue
-            array = _as_array(getattr(self, name))
+            array = require_float_array(name, getattr(self, name))
             if array.shape != (n, 3, 3) or not np.all(np.isfinite(array)):
                 raise ValueError(f"{name} must be a finite {n}×3×3 array, got shape {array.shape}")
             object.__setattr__(self, name, array)
@@ -276,18 +282,20 @@ class ClusterContainmentParams:
     @property
     def true_inertias(self) -> np.ndarray:
         """J_i = J_0i + ΔJ_i (eq. 5), N×3×3 (ΔJ_i = 0 when ``inertia_uncertainty`` is None)."""
-        nominal = _as_array(self.nominal_inertias)
+        nominal = require_float_array("nominal_inertias", self.nominal_inertias)
         if self.inertia_uncertainty is None:
             return nominal.copy()
-        return nominal + _as_array(self.inertia_uncertainty)
+        return nominal + require_float_array("inertia_uncertainty", self.inertia_uncertainty)
 
 
 def replace_params(
-    params: ClusterContainmentParams, overrides: dict[str, object]
+    params: ClusterContainmentParams | None, overrides: dict[str, object]
 ) -> ClusterContainmentParams:
-    """``params`` with ``overrides`` applied; a new ``scenario`` restores that scenario's arrays
-    for every N/M-sized field not overridden. Unknown names raise ``TypeError``."""
-    if "scenario" in overrides and overrides["scenario"] != params.scenario:
+    """``params`` (``None`` for the defaults) with ``overrides`` applied; a new ``scenario``
+    restores that scenario's arrays for every N/M-sized field not overridden. Unknown names and
+    a ``params`` of another type raise ``TypeError``."""
+    current = params.scenario if isinstance(params, ClusterContainmentParams) else "paper"
+    if "scenario" in overrides and overrides["scenario"] != current:
         reset = dict.fromkeys((*_scenario_defaults("paper"), "inertia_uncertainty"))
         overrides = {**reset, **overrides}
-    return apply_overrides(params, overrides, "the cluster environments")
+    return apply_overrides(ClusterContainmentParams, params, overrides, "the cluster environments")

@@ -13,6 +13,13 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
+from etsc_envs.core.validation import require_float_array
+
+MAX_WEIGHT = 1e6
+"""Largest accepted a_ij. The paper's graphs have unit weights; the control law (19) and the
+sliding variable (10) multiply states by the weights and their sums, which overflow to
+``inf`` for weights near the float range (1e308 did on the first step)."""
+
 
 def adjacency_from_edges(n_nodes: int, edges: Iterable[tuple[int, int]]) -> np.ndarray:
     """Unit-weight adjacency matrix with ``a[i, j] = 1`` for each ``(receiver i, sender j)``."""
@@ -60,19 +67,22 @@ def validate_adjacency(
 ) -> np.ndarray:
     """``value`` as an ``(N+M)×(N+M)`` adjacency matrix, or ``ValueError`` saying what is wrong.
 
-    Checks: finite non-negative weights, no self-edges (``a_ii = 0``), no information into a
-    leader (the paper's stationary leaders are not affected by other members) and
+    Checks: finite weights in [0, :data:`MAX_WEIGHT`], no self-edges (``a_ii = 0``), no
+    information into a leader (the paper's stationary leaders are not affected by other members) and
     Assumption 3 (every follower is reached by at least one leader).
     """
     n_nodes = n_followers + n_leaders
-    matrix = np.asarray(value, dtype=float)
+    matrix = require_float_array(name, value)
     if matrix.shape != (n_nodes, n_nodes) or not np.all(np.isfinite(matrix)):
         raise ValueError(
             f"{name} must be a finite {n_nodes}x{n_nodes} matrix ({n_followers} followers then "
             f"{n_leaders} leaders), got shape {matrix.shape}"
         )
-    if np.any(matrix < 0.0):
-        raise ValueError(f"{name} must have weights a_ij >= 0")
+    if np.any(matrix < 0.0) or np.any(matrix > MAX_WEIGHT):
+        raise ValueError(
+            f"{name} must have weights 0 <= a_ij <= {MAX_WEIGHT:g}, got a largest of "
+            f"{matrix.max():g} and a smallest of {matrix.min():g}"
+        )
     if np.any(np.diag(matrix) != 0.0):
         raise ValueError(f"{name} must have a zero diagonal (no self-edges, a_ii = 0)")
     if np.any(matrix[n_followers:] != 0.0):

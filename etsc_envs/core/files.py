@@ -9,8 +9,10 @@ file where a finished one is expected.
 
 from __future__ import annotations
 
+import argparse
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 
@@ -44,6 +46,35 @@ def require_writable_folder(path: str | Path, argument: str) -> Path:
                 raise ValueError(f"{argument} cannot be written: {str(candidate)!r} is read-only")
             break
     return path
+
+
+def output_file_argument(argument: str, *, stdout: bool = True) -> Callable[[str], str]:
+    """An argparse ``type=`` for an output file option: the command line is refused at parse
+    time, with one line naming ``argument``, when the file cannot be written (``-`` passes
+    through as standard output if ``stdout``)."""
+
+    def checked(value: str) -> str:
+        if stdout and value == "-":
+            return value
+        try:
+            require_writable_file(value, argument)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error)) from None
+        return value
+
+    return checked
+
+
+def output_folder_argument(argument: str) -> Callable[[str], Path]:
+    """An argparse ``type=`` for an output folder option (see :func:`output_file_argument`)."""
+
+    def checked(value: str) -> Path:
+        try:
+            return require_writable_folder(value, argument)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error)) from None
+
+    return checked
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:

@@ -35,7 +35,13 @@ from etsc_envs.core.compiled_loop import (
     make_loop_step,
 )
 from etsc_envs.core.metrics import communication_metrics
-from etsc_envs.core.validation import require_non_negative, require_positive
+from etsc_envs.core.validation import (
+    require_bool,
+    require_non_negative,
+    require_positive,
+    require_reset_options,
+    step_count,
+)
 
 
 class EventTriggeredEnv(gym.Env):
@@ -56,11 +62,19 @@ class EventTriggeredEnv(gym.Env):
         cost_scale: divisor of the accuracy cost in the reward.
         failure_cost: the cost charged for every step a failure cuts from the horizon, so that
             ending an episode by diverging never pays more than staying in control.
+        randomize: whether ``_reset_problem`` draws the episode's start (``True``/``False``
+            only).
+
+    ``reset()`` takes the ``options`` keys of :attr:`reset_options` (none by default) and
+    refuses others. An env can be pickled at any point (the compiled entry is rebuilt on the
+    next step) and the copy continues exactly as the original would.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
     kernels: ClassVar[ProblemKernels]
     loop_step: ClassVar[Callable[..., None]]
+    reset_options: ClassVar[tuple[str, ...]] = ()
+    """The keys ``reset(options=...)`` accepts."""
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -82,20 +96,17 @@ class EventTriggeredEnv(gym.Env):
         transmission_penalty: float,
         cost_scale: float,
         failure_cost: float,
+        randomize: bool = False,
     ) -> None:
+        self.randomize = require_bool("randomize", randomize)
         self.sampling_period_s = require_positive("sampling_period_s", sampling_period_s)
         self.horizon_s = require_positive("horizon_s", horizon_s)
-        if self.horizon_s < self.sampling_period_s:
-            raise ValueError(
-                f"horizon_s must be >= sampling_period_s ({self.sampling_period_s} s), "
-                f"got {horizon_s}"
-            )
+        self.n_steps = step_count(self.horizon_s, self.sampling_period_s)
         self.transmission_penalty = require_non_negative(
             "transmission_penalty", transmission_penalty
         )
         self.cost_scale = require_positive("cost_scale", cost_scale)
         self.failure_cost = require_non_negative("failure_cost", failure_cost)
-        self.n_steps = round(self.horizon_s / self.sampling_period_s)
         self.n_channels = n_channels
         self.constants = constants
 
@@ -117,6 +128,7 @@ class EventTriggeredEnv(gym.Env):
         self.loop_shape = (n_channels, channel_width, self.n_features, state_width)
         self._actions = np.zeros((1, n_channels), dtype=np.int64)
         self._active = np.ones(1, dtype=bool)
+        self._has_reset = False
         self.bind(allocate_loop_arrays(1, *self.loop_shape))
 
     def bind(self, arrays: LoopArrays) -> None:
@@ -124,6 +136,19 @@ class EventTriggeredEnv(gym.Env):
         self.arrays = arrays
         self.state = arrays.state[0]
         self._loop_step_entry = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Everything but the compiled entry point (machine code, not picklable; rebuilt from
+        the disk cache on the next step)."""
+        state = self.__dict__.copy()
+        state["_loop_step_entry"] = None
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Restore, binding :attr:`state` to the restored arrays again (pickle copies a view
+        as an array of its own)."""
+        self.__dict__.update(state)
+        self.bind(self.arrays)
 
     # ----------------------------------------------------------------- problem hooks
     def _reset_problem(self, options: dict[str, Any] | None) -> None:
@@ -195,12 +220,14 @@ class EventTriggeredEnv(gym.Env):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        options = require_reset_options(options, self.reset_options)
         super().reset(seed=seed)
+        self._has_reset = True
         arrays = self.arrays
         for array in arrays:  # the state row included: _reset_problem starts from zeros
             array[0] = 0
         arrays.interevent_min_s[0] = np.inf
-        self._reset_problem(options)
+        self._reset_problem(options or None)
         arrays.held[0] = self._initial_held()
         features = np.empty(self.n_features)
         self.kernels.features(self.state, self.constants, features)
@@ -214,6 +241,8 @@ class EventTriggeredEnv(gym.Env):
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         arrays = self.arrays
+        if not self._has_reset:
+            raise gym.error.ResetNeeded("step() called before reset(); call reset() first")
         if arrays.failure_code[0] != 0 or arrays.step_index[0] >= self.n_steps:
             raise RuntimeError("step() called after the episode ended; call reset() first")
         self._set_transmit_bits(action)

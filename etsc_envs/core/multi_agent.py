@@ -23,6 +23,7 @@ central env's reward.
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -32,6 +33,7 @@ from pettingzoo import ParallelEnv
 from etsc_envs.core.compiled_loop import LoopArrays
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.metrics import interevent_summary
+from etsc_envs.core.validation import require_reset_options
 
 CLOCK_NAME = "time_since_transmission_s"
 
@@ -131,7 +133,7 @@ class EventTriggeredParallelEnv(ParallelEnv):
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
-        observation, _ = self.loop.reset(seed=seed, options=options)
+        observation, _ = self.loop.reset(seed=seed, options=self._loop_options(options))
         self.agents = list(self.possible_agents)
         infos = {agent: self.loop.reset_info() for agent in self.agents}
         return self._split(observation), infos
@@ -195,6 +197,22 @@ class EventTriggeredParallelEnv(ParallelEnv):
         return self.loop.n_steps
 
     # ----------------------------------------------------------------- internals
+    def _loop_options(self, options: Any) -> dict[str, Any]:
+        """The loop's reset options among ``options``. A non-mapping is refused; unknown keys
+        are dropped with a warning naming them rather than refused, because PettingZoo's own
+        API tests (``parallel_api_test``, ``api_test``) reset with ``options={"options": 1}``."""
+        allowed = self.loop.reset_options
+        if not isinstance(options, dict):
+            return require_reset_options(options, allowed)
+        unknown = sorted(str(key) for key in options if key not in allowed)
+        if unknown:
+            warnings.warn(
+                f"options: unknown key(s) {unknown} ignored; this environment's reset takes "
+                f"{list(allowed) or 'no options'}",
+                stacklevel=3,
+            )
+        return {key: value for key, value in options.items() if key in allowed}
+
     def _split(self, observation: np.ndarray) -> dict[str, np.ndarray]:
         self._state = observation
         blocks = observation[self._index]

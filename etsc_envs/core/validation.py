@@ -14,7 +14,8 @@ def _real_number(name: str, value: float, allowed: str) -> float:
     """``value`` as a float, or ``ValueError`` if it is not a real number (a string, say)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(
-            f"{name} must be a finite number {allowed}, got {value!r} ({type(value).__name__})"
+            f"{name} must be a finite number{' ' if allowed else ''}{allowed}, "
+            f"got {value!r} ({type(value).__name__})"
         )
     return float(value)
 
@@ -43,11 +44,30 @@ def require_choice(name: str, value: str, choices: Iterable[str]) -> str:
     return value
 
 
+def require_bool(name: str, value: bool) -> bool:
+    """``value`` as a ``bool``, or ``ValueError`` unless it is ``True`` or ``False`` (a string
+    such as ``"no"`` or a number is refused rather than read by its truth value)."""
+    if not isinstance(value, bool | np.bool_):
+        raise ValueError(f"{name} must be True or False, got {value!r} ({type(value).__name__})")
+    return bool(value)
+
+
+def require_float_array(name: str, value: Any) -> np.ndarray:
+    """``value`` as a float64 array, or ``ValueError`` naming ``name`` if it is text or cannot
+    be read as numbers (a ragged nesting, say)."""
+    if isinstance(value, str | bytes):
+        raise ValueError(f"{name} must be numbers, got the text {value!r}")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be numbers, got {value!r}") from None
+
+
 def require_vector(
     name: str, value: Iterable[float], length: int, *, positive: bool = False
 ) -> np.ndarray:
     """``value`` as a finite float64 vector of ``length`` entries (all > 0 if ``positive``)."""
-    array = np.asarray(value, dtype=float)
+    array = require_float_array(name, value)
     if array.shape != (length,) or not np.all(np.isfinite(array)):
         raise ValueError(
             f"{name} must be {length} finite numbers, got shape {array.shape}: {value!r}"
@@ -72,7 +92,7 @@ def require_unit_quaternion(
 
 def require_spd_matrix(name: str, value: Iterable[Iterable[float]]) -> np.ndarray:
     """``value`` as a symmetric positive-definite 3×3 matrix, or ``ValueError`` saying why not."""
-    matrix = np.asarray(value, dtype=float)
+    matrix = require_float_array(name, value)
     if matrix.shape != (3, 3) or not np.all(np.isfinite(matrix)):
         raise ValueError(f"{name} must be a finite 3x3 matrix, got shape {matrix.shape}")
     if not np.allclose(matrix, matrix.T, rtol=0.0, atol=1e-12 * max(1.0, np.abs(matrix).max())):
@@ -84,11 +104,86 @@ def require_spd_matrix(name: str, value: Iterable[Iterable[float]]) -> np.ndarra
     return matrix
 
 
-def apply_overrides(params: Any, overrides: dict[str, Any], owner: str) -> Any:
-    """``params`` (a frozen dataclass) with ``overrides`` applied field by field, validated again.
+def step_count(horizon_s: float, sampling_period_s: float) -> int:
+    """The sampling instants in ``horizon_s``, or ``ValueError`` unless the horizon is a whole
+    number of sampling periods (within a relative 1e-9, for decimal fractions)."""
+    periods = horizon_s / sampling_period_s
+    count = round(periods)
+    if count < 1 or abs(periods - count) > 1e-9 * periods:
+        raise ValueError(
+            f"horizon_s must be a whole number (>= 1) of sampling periods "
+            f"({sampling_period_s} s), got {horizon_s} s = {periods:.6g} periods"
+        )
+    return count
 
-    Raises ``TypeError`` naming ``owner`` and the unknown keyword(s) if an override is not a field.
+
+def require_reset_options(options: Any, allowed: Iterable[str] = ()) -> dict[str, Any]:
+    """``options`` of ``reset()`` as a dict (``{}`` for ``None``), or ``ValueError`` if it is
+    not a mapping or holds a key outside ``allowed``."""
+    allowed = tuple(allowed)
+    if options is None:
+        return {}
+    if not isinstance(options, dict):
+        raise ValueError(
+            f"options must be None or a dict with keys in {list(allowed)}, "
+            f"got {options!r} ({type(options).__name__})"
+        )
+    unknown = sorted(str(key) for key in options if key not in allowed)
+    if unknown:
+        takes = f"takes only {list(allowed)}" if allowed else "takes no options"
+        raise ValueError(f"options: unknown key(s) {unknown}; this environment's reset {takes}")
+    return dict(options)
+
+
+def _annotation_names(annotation: Any) -> set[str]:
+    """The type names of a field annotation (a string under postponed evaluation)."""
+    text = annotation if isinstance(annotation, str) else getattr(annotation, "__name__", "")
+    return {part.strip() for part in str(text).split("|")}
+
+
+def require_field_types(params: Any) -> None:
+    """``ValueError`` naming the first field of the dataclass ``params`` whose value does not
+    fit its annotation: ``bool`` fields take only ``True``/``False``, ``int`` and ``float``
+    fields real numbers (not text, not bools), ``str`` fields text, ``tuple`` fields numbers
+    (any nesting NumPy reads as a float array); ``| None`` admits ``None``. Range checks stay
+    with each parameter class."""
+    for field in dataclasses.fields(params):
+        names = _annotation_names(field.type)
+        value = getattr(params, field.name)
+        if value is None and "None" in names:
+            continue
+        if "bool" in names:
+            require_bool(field.name, value)
+        elif "int" in names:
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+                raise ValueError(
+                    f"{field.name} must be an integer, got {value!r} ({type(value).__name__})"
+                )
+        elif "float" in names:
+            _real_number(field.name, value, "")
+        elif "str" in names:
+            if not isinstance(value, str):
+                raise ValueError(
+                    f"{field.name} must be a string, got {value!r} ({type(value).__name__})"
+                )
+        elif "tuple" in names:
+            require_float_array(field.name, value)
+
+
+def apply_overrides(params_class: type, params: Any, overrides: dict[str, Any], owner: str) -> Any:
+    """``params`` (a frozen dataclass of ``params_class``; ``None`` for its defaults) with
+    ``overrides`` applied field by field, validated again.
+
+    Raises ``TypeError`` naming ``owner`` if ``params`` is of another type or an override is
+    not a field.
     """
+    if params is None:
+        params = params_class()
+    elif not isinstance(params, params_class):
+        raise TypeError(
+            f"params of {owner} must be None or a {params_class.__name__}, "
+            f"got {params!r} ({type(params).__name__})"
+        )
     unknown = set(overrides) - {field.name for field in dataclasses.fields(params)}
     if unknown:
         raise TypeError(f"unknown argument(s) for {owner}: {sorted(unknown)}")

@@ -30,6 +30,7 @@ from gymnasium.vector.utils import batch_space
 
 from etsc_envs.core.compiled_loop import allocate_loop_arrays, compiled_entry, loop_rows
 from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.validation import require_reset_options
 
 ROWS_PER_THREAD_MIN = 8
 """A batch gets one more thread for every this many rows, up to one per available core
@@ -95,22 +96,39 @@ class EventTriggeredVectorEnv(VectorEnv):
         self.envs = [self.single_env_class(**env_kwargs) for _ in range(self.num_envs)]
         first = self.envs[0]
         self.arrays = allocate_loop_arrays(self.num_envs, *first.loop_shape)
-        for index, env in enumerate(self.envs):
-            env.bind(loop_rows(self.arrays, index, index + 1))
         self.single_observation_space = first.observation_space
         self.single_action_space = first.action_space
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.render_mode = None
-        self._chunks = _row_chunks(self.num_envs, _worker_count(self.num_envs))
-        self._pool = ThreadPoolExecutor(len(self._chunks)) if len(self._chunks) > 1 else None
-        self._chunk_arrays = [loop_rows(self.arrays, *chunk) for chunk in self._chunks]
-        self._loop_step_entry = None
+        self._bind_rows()
         self._actions = np.zeros((self.num_envs, first.n_channels), dtype=np.int64)
         self._needs_reset = np.ones(self.num_envs, dtype=bool)
         self.channel_rewards = np.zeros((self.num_envs, first.n_channels))
         """Each sub-environment's reward split by channel at the last step (taken before a
         same-step reset), for training one policy per channel."""
+
+    def _bind_rows(self) -> None:
+        """Bind each sub-environment to its row of :attr:`arrays` and split the rows among the
+        stepping threads."""
+        for index, env in enumerate(self.envs):
+            env.bind(loop_rows(self.arrays, index, index + 1))
+        self._chunks = _row_chunks(self.num_envs, _worker_count(self.num_envs))
+        self._pool = ThreadPoolExecutor(len(self._chunks)) if len(self._chunks) > 1 else None
+        self._chunk_arrays = [loop_rows(self.arrays, *chunk) for chunk in self._chunks]
+        self._loop_step_entry = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Everything but the thread pool, the compiled entry point and the row views (pickle
+        would copy a view as an array of its own), rebuilt by :meth:`__setstate__`."""
+        state = self.__dict__.copy()
+        for name in ("_pool", "_loop_step_entry", "_chunks", "_chunk_arrays"):
+            state.pop(name, None)
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._bind_rows()
 
     # ----------------------------------------------------------------- Gymnasium API
     def reset(
@@ -127,7 +145,9 @@ class EventTriggeredVectorEnv(VectorEnv):
         seeds = self._seeds(seed)
         if isinstance(seed, int):
             super().reset(seed=seed)
-        env_options = dict(options or {})
+        env_options = require_reset_options(
+            options, ("reset_mask", *self.single_env_class.reset_options)
+        )
         mask = np.asarray(env_options.pop("reset_mask", np.ones(self.num_envs, dtype=bool)))
         if mask.shape != (self.num_envs,) or mask.dtype != np.bool_:
             raise ValueError(

@@ -99,10 +99,7 @@ class InnerFormationEnv(EventTriggeredEnv):
         randomize: bool = False,
         **overrides: Any,
     ) -> None:
-        self.params = apply_overrides(
-            params if params is not None else InnerFormationParams(), overrides, "InnerFormationEnv"
-        )
-        self.randomize = bool(randomize)
+        self.params = apply_overrides(InnerFormationParams, params, overrides, "InnerFormationEnv")
         p = self.params
         self.design = ObserverFeedback(
             gain=np.array(p.observer_gain, dtype=float),
@@ -137,6 +134,7 @@ class InnerFormationEnv(EventTriggeredEnv):
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
+            randomize=randomize,
             failure_cost=p.cavity_radius_m,
         )
 

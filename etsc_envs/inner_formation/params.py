@@ -7,7 +7,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from etsc_envs.core.validation import require_choice, require_positive, require_vector
+from etsc_envs.core.validation import (
+    require_choice,
+    require_field_types,
+    require_positive,
+    require_vector,
+)
 
 OBSERVER_STARTS = ("first_measurement", "zero")
 
@@ -62,6 +67,7 @@ class InnerFormationParams:
     """Failure bound on ‖r_12‖: the inner mass touching its cavity's wall ends the episode."""
 
     def __post_init__(self) -> None:
+        require_field_types(self)
         for name in (
             "orbit_rate",
             "disturbance_amplitude",

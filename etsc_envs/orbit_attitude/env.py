@@ -256,13 +256,8 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         **overrides: Any,
     ) -> None:
         self.params = apply_overrides(
-            params if params is not None else OrbitAttitudeParams(),
-            overrides,
-            "OrbitAttitudeTrackingEnv",
+            OrbitAttitudeParams, params, overrides, "OrbitAttitudeTrackingEnv"
         )
-        if not isinstance(randomize, bool | np.bool_):
-            raise ValueError(f"randomize must be True or False, got {randomize!r}")
-        self.randomize = bool(randomize)
         p = self.params
         low = np.full(N_FEATURES, -np.inf)
         high = np.full(N_FEATURES, np.inf)
@@ -282,6 +277,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             horizon_s=p.horizon_s,
             transmission_penalty=transmission_penalty,
             cost_scale=cost_scale,
+            randomize=randomize,
             failure_cost=float(tracking_cost(failure_eta, failure_twist, COST_REFERENCE)),
         )
 

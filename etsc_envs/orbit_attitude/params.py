@@ -15,6 +15,7 @@ import numpy as np
 
 from etsc_envs.core.validation import (
     require_choice,
+    require_field_types,
     require_non_negative,
     require_positive,
     require_spd_matrix,
@@ -179,6 +180,7 @@ class OrbitAttitudeParams:
     """Failure bound on ‖Δv‖."""
 
     def __post_init__(self) -> None:
+        require_field_types(self)
         for name in (
             "gravitational_parameter",
             "earth_radius_m",

@@ -1,0 +1,569 @@
+"""Hostile input: every env keyword, reset option, pickled env and command line of issue 17.
+
+Checked properties: bad input ends in one line naming the argument and what it allows
+(``ValueError``/``TypeError`` from Python, exit status 2 from a command line), never a silent
+reading of it nor a raw traceback; the same checks reach every parameter class field by field,
+so a keyword added later is covered without a new test; an env pickled at any point continues
+bit for bit; output paths are checked before the work starts.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import pickle
+import zipfile
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import etsc_envs
+from etsc_envs.asteroid.params import AsteroidParams
+from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
+from etsc_envs.cluster.params import ClusterContainmentParams
+from etsc_envs.inner_formation.params import InnerFormationParams
+from etsc_envs.orbit_attitude.params import OrbitAttitudeParams
+
+GYM_IDS = sorted(etsc_envs.ENV_IDS)
+PETTINGZOO_ID = "etsc/ClusterContainment-v0"
+MODELS = Path(__file__).parents[1] / "models"
+SHORT = {
+    "etsc/AttitudeTracking-v0": {"horizon_s": 0.05},
+    "etsc/InnerFormation-v0": {"horizon_s": 0.05},
+    "etsc/OrbitAttitudeTracking-v0": {"horizon_s": 0.05},
+    "etsc/ClusterContainmentCentral-v0": {"horizon_s": 0.5},
+    "etsc/AsteroidOrbitKeeping-v0": {"horizon_s": 60.0},
+}
+PARAMS_CLASSES = [
+    AttitudeTrackingParams,
+    InnerFormationParams,
+    OrbitAttitudeParams,
+    ClusterContainmentParams,
+    AsteroidParams,
+]
+
+
+def raw_env(env_id: str, **kwargs):
+    """The env class itself, as a user constructing it directly would."""
+    return gym.spec(env_id).make(**kwargs).unwrapped
+
+
+def assert_one_line(error: pytest.ExceptionInfo, *names: str) -> None:
+    message = str(error.value)
+    assert "\n" not in message, message
+    for name in names:
+        assert name in message, message
+
+
+def bits(env, value: int):
+    return value if env.action_space.shape == () else np.full(env.action_space.shape, value)
+
+
+# ----------------------------------------------------------------------- env keywords
+@pytest.mark.parametrize("env_id", GYM_IDS)
+def test_randomize_must_be_a_bool(env_id: str) -> None:
+    with pytest.raises(ValueError) as error:
+        gym.make(env_id, randomize="no")
+    assert_one_line(error, "randomize")
+
+
+def test_pettingzoo_randomize_must_be_a_bool() -> None:
+    with pytest.raises(ValueError) as error:
+        etsc_envs.make_parallel(PETTINGZOO_ID, randomize="no")
+    assert_one_line(error, "randomize")
+
+
+def _wrong_kind(annotation) -> object:
+    """A value of the wrong kind for a field annotated ``annotation`` (a string such as
+    ``"float | None"``: the parameter modules postpone the evaluation of annotations)."""
+    names = {part.strip() for part in str(annotation).split("|")}
+    if "bool" in names:
+        return "no"
+    if "int" in names or "float" in names or "tuple" in names:
+        return "abc"
+    if "str" in names:
+        return 3
+    return None
+
+
+PARAMETER_FIELDS = [
+    pytest.param(cls, field.name, id=f"{cls.__name__}.{field.name}")
+    for cls in PARAMS_CLASSES
+    for field in dataclasses.fields(cls)
+    if _wrong_kind(field.type) is not None
+]
+
+
+@pytest.mark.parametrize(("params_class", "name"), PARAMETER_FIELDS)
+def test_every_parameter_refuses_a_value_of_the_wrong_kind(params_class, name: str) -> None:
+    field = next(f for f in dataclasses.fields(params_class) if f.name == name)
+    with pytest.raises(ValueError) as error:
+        params_class(**{name: _wrong_kind(field.type)})
+    assert_one_line(error, name)
+
+
+@pytest.mark.parametrize("env_id", GYM_IDS)
+@pytest.mark.parametrize("keyword", ["transmission_penalty", "cost_scale"])
+def test_reward_keywords_refuse_text(env_id: str, keyword: str) -> None:
+    with pytest.raises(ValueError) as error:
+        gym.make(env_id, **{keyword: "0.1"})
+    assert_one_line(error, keyword)
+
+
+def test_a_vector_parameter_refuses_text() -> None:
+    with pytest.raises(ValueError) as error:
+        gym.make("etsc/AttitudeTracking-v0", observer_epsilon="abc")
+    assert_one_line(error, "observer_epsilon")
+
+
+@pytest.mark.parametrize("env_id", GYM_IDS)
+def test_params_must_be_the_envs_parameter_class(env_id: str) -> None:
+    with pytest.raises(TypeError) as error:
+        gym.make(env_id, params="x")
+    assert_one_line(error, "params")
+
+
+def test_horizon_must_be_a_whole_number_of_sampling_periods() -> None:
+    with pytest.raises(ValueError) as error:
+        gym.make("etsc/AttitudeTracking-v0", horizon_s=0.0015)
+    assert_one_line(error, "horizon_s", "0.001")
+    assert gym.make("etsc/AttitudeTracking-v0", horizon_s=0.003).unwrapped.n_steps == 3
+
+
+def test_cluster_adjacency_weights_are_bounded() -> None:
+    adjacency = np.array(ClusterContainmentParams().adjacency)
+    adjacency[adjacency > 0] = 1e308
+    with pytest.raises(ValueError) as error:
+        gym.make("etsc/ClusterContainmentCentral-v0", adjacency=adjacency)
+    assert_one_line(error, "adjacency")
+
+
+def test_cluster_largest_accepted_weight_keeps_the_observation_finite() -> None:
+    from etsc_envs.cluster.topology import MAX_WEIGHT
+
+    adjacency = np.array(ClusterContainmentParams().adjacency)
+    adjacency[adjacency > 0] = MAX_WEIGHT
+    env = gym.make("etsc/ClusterContainmentCentral-v0", adjacency=adjacency, horizon_s=0.5)
+    observation, _ = env.reset(seed=0)
+    for _ in range(5):
+        observation, *_ = env.step(np.ones(env.action_space.shape, dtype=np.int64))
+        assert np.all(np.isfinite(observation))
+
+
+def test_cluster_leaders_must_lie_in_the_mrp_unit_ball() -> None:
+    leaders = np.array(ClusterContainmentParams().leader_attitudes)
+    leaders[0] = [1.2, 0.0, 0.0]
+    with pytest.raises(ValueError) as error:
+        gym.make("etsc/ClusterContainmentCentral-v0", leader_attitudes=leaders)
+    assert_one_line(error, "leader_attitudes")
+
+
+@pytest.mark.parametrize("unit", [-1.0, 0.0, np.nan, "km"])
+def test_asteroid_shape_length_unit_must_be_positive(unit) -> None:
+    with pytest.raises(ValueError) as error:
+        gym.make("etsc/AsteroidOrbitKeeping-v0", shape_length_unit_m=unit)
+    assert_one_line(error, "shape_length_unit_m")
+
+
+# ----------------------------------------------------------------------- reset and step
+@pytest.mark.parametrize("env_id", GYM_IDS)
+@pytest.mark.parametrize("options", [{"foo": 1}, "string"])
+def test_reset_refuses_unknown_options(env_id: str, options) -> None:
+    env = gym.make(env_id)
+    with pytest.raises(ValueError) as error:
+        env.reset(options=options)
+    assert_one_line(error, "options")
+    env.reset(options={})  # an empty mapping is no option at all
+
+
+@pytest.mark.parametrize("options", [{"foo": 1}, "string"])
+def test_vector_reset_refuses_unknown_options(options) -> None:
+    vector = gym.make_vec(
+        "etsc/AttitudeTracking-v0", num_envs=2, vectorization_mode="vector_entry_point"
+    )
+    with pytest.raises(ValueError) as error:
+        vector.reset(options=options)
+    assert_one_line(error, "options")
+
+
+def test_pettingzoo_reset_refuses_a_non_mapping_and_warns_of_unknown_keys() -> None:
+    parallel = etsc_envs.make_parallel(PETTINGZOO_ID)
+    with pytest.raises(ValueError) as error:
+        parallel.reset(options="string")
+    assert_one_line(error, "options")
+    # PettingZoo's API test resets with options={"options": 1}: named, not refused
+    with pytest.warns(UserWarning, match=r"unknown key\(s\) \['foo'\]"):
+        parallel.reset(options={"foo": 1})
+
+
+@pytest.mark.parametrize("env_id", GYM_IDS)
+def test_stepping_the_raw_env_before_reset_is_refused(env_id: str) -> None:
+    env = raw_env(env_id)
+    with pytest.raises(gym.error.ResetNeeded):
+        env.step(bits(env, 0))
+
+
+# ----------------------------------------------------------------------- pickling
+def _run(env, steps: int, rng: np.random.Generator) -> list[tuple]:
+    out = []
+    for _ in range(steps):
+        observation, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+        out.append((observation.tobytes(), float(reward), terminated, truncated))
+        if terminated or truncated:
+            break
+    return out
+
+
+@pytest.mark.parametrize("env_id", GYM_IDS)
+def test_a_pickled_env_continues_bit_for_bit(env_id: str) -> None:
+    env = gym.make(env_id, randomize=True, **SHORT[env_id])
+    env.reset(seed=11)
+    env.action_space.seed(5)
+    for _ in range(3):
+        env.step(env.action_space.sample())
+    clone = pickle.loads(pickle.dumps(env))
+    env.action_space.seed(6)
+    clone.action_space.seed(6)
+    rng = np.random.default_rng(0)
+    assert _run(clone, 10, rng) == _run(env, 10, rng)
+    assert clone.unwrapped.episode_metrics() == env.unwrapped.episode_metrics()
+    # the next episode too (the copied random generator)
+    assert np.array_equal(clone.reset()[0], env.reset()[0])
+
+
+@pytest.mark.parametrize("env_id", GYM_IDS)
+def test_a_pickled_vector_env_continues_bit_for_bit(env_id: str) -> None:
+    vector = gym.make_vec(
+        env_id,
+        num_envs=3,
+        vectorization_mode="vector_entry_point",
+        randomize=True,
+        **SHORT[env_id],
+    )
+    vector.reset(seed=2)
+    vector.action_space.seed(1)
+    vector.step(vector.action_space.sample())
+    clone = pickle.loads(pickle.dumps(vector))
+    for _ in range(8):
+        actions = vector.action_space.sample()
+        expected = vector.step(actions)
+        got = clone.step(actions)
+        for a, b in zip(expected[:4], got[:4], strict=True):
+            assert np.array_equal(a, b)
+    # each sub-environment still lives in its row of the restored batch
+    clone.unwrapped.envs[1].state[0] = 123.0
+    assert clone.unwrapped.arrays.state[1, 0] == 123.0
+
+
+def test_a_pickled_pettingzoo_env_continues_bit_for_bit() -> None:
+    env = etsc_envs.make_parallel(PETTINGZOO_ID, horizon_s=0.5, randomize=True)
+    env.reset(seed=4)
+    actions = {agent: 1 for agent in env.agents}
+    env.step(actions)
+    clone = pickle.loads(pickle.dumps(env))
+    for step in range(5):
+        actions = {agent: (step + i) % 2 for i, agent in enumerate(env.agents)}
+        expected, got = env.step(actions), clone.step(actions)
+        for agent in env.possible_agents:
+            assert np.array_equal(expected[0][agent], got[0][agent])
+            assert expected[1][agent] == got[1][agent]
+
+
+# ----------------------------------------------------------------------- command lines
+def _error_line(capsys) -> str:
+    lines = [line for line in capsys.readouterr().err.splitlines() if "error:" in line]
+    assert len(lines) == 1, lines
+    assert "Traceback" not in capsys.readouterr().err
+    return lines[0]
+
+
+def test_evaluate_refuses_a_folder_for_json_before_running(tmp_path: Path, capsys) -> None:
+    from baselines.evaluate import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--policy", "paper", "--json", str(tmp_path)])
+    assert exit_info.value.code == 2
+    assert "--json" in _error_line(capsys)
+
+
+def test_benchmark_refuses_a_json_path_under_a_file(tmp_path: Path, capsys) -> None:
+    from etsc_envs.benchmark import main
+
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--steps", "1", "--json", str(blocker / "out.json")])
+    assert exit_info.value.code == 2
+    assert "--json" in _error_line(capsys)
+
+
+def test_results_refuses_an_unknown_id(capsys) -> None:
+    from agents.results import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/Nope-v0", "--model", str(MODELS / "AttitudeTracking-v0_ppo.zip")])
+    assert exit_info.value.code == 2
+    assert "etsc/Nope-v0" in _error_line(capsys)
+
+
+def _broken_model(tmp_path: Path, how: str) -> Path:
+    source = MODELS / "AttitudeTracking-v0_ppo.zip"
+    target = tmp_path / "model.zip"
+    if how == "truncated":
+        target.write_bytes(source.read_bytes()[:2000])
+    elif how == "garbage":
+        target.write_bytes(b"not a zip at all")
+    elif how == "no data":
+        with zipfile.ZipFile(target, "w") as archive:
+            archive.writestr("policy.pth", b"")
+    elif how == "garbage statistics":
+        target.write_bytes(source.read_bytes())
+        (tmp_path / "model_vecnormalize.pkl").write_bytes(b"\x80\x04garbage")
+    return target
+
+
+@pytest.mark.parametrize("how", ["truncated", "garbage", "no data", "garbage statistics"])
+def test_evaluate_refuses_a_damaged_model_with_one_line(tmp_path: Path, capsys, how) -> None:
+    from baselines.evaluate import main
+
+    model = _broken_model(tmp_path, how)
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--policy", f"sb3:{model}", "--env-arg=horizon_s=0.05"])
+    assert exit_info.value.code == 2
+    assert str(tmp_path) in _error_line(capsys)
+
+
+@pytest.mark.parametrize("tool", ["results", "pareto"])
+def test_results_and_pareto_refuse_a_damaged_model(tmp_path: Path, capsys, tool) -> None:
+    from agents.pareto import main as pareto_main
+    from agents.results import main as results_main
+
+    model = _broken_model(tmp_path, "truncated")
+    main = results_main if tool == "results" else pareto_main
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--model", str(model), "--out", str(tmp_path / "o")])
+    assert exit_info.value.code == 2
+    assert "model.zip" in _error_line(capsys)
+
+
+def test_a_model_of_another_env_names_both_spaces(capsys) -> None:
+    from baselines.evaluate import main
+
+    model = MODELS / "AttitudeTracking-v0_ppo.zip"
+    with pytest.raises(SystemExit):
+        main(["etsc/InnerFormation-v0", "--policy", f"sb3:{model}", "--env-arg=horizon_s=0.05"])
+    line = _error_line(capsys)
+    assert "(14,)" in line and "(18,)" in line and "etsc/InnerFormation-v0" in line, line
+
+
+# ----------------------------------------------------------------------- training
+def tiny_training_config(out_dir: Path, **changes) -> dict:
+    """A PPO run of a few seconds on 50-step episodes of paper 002."""
+    config = {
+        "env_id": "etsc/AttitudeTracking-v0",
+        "env_kwargs": {"horizon_s": 0.05, "cost_scale": 0.01},
+        "algorithm": "PPO",
+        "policy": "MlpPolicy",
+        "hyperparameters": {"n_steps": 64, "batch_size": 64, "n_epochs": 1},
+        "total_timesteps": 192,
+        "n_envs": 1,
+        "out_dir": str(out_dir),
+        "normalize_observations": True,
+        "tensorboard": False,
+        "checkpoint_every": 64,
+        "evaluation_every": 64,
+        "evaluation_env_kwargs": {"horizon_s": 0.05},
+    }
+    config.update(changes)
+    return config
+
+
+def train_main(tmp_path: Path, config: dict, *extra: str) -> int:
+    import yaml
+
+    from agents.train import main
+
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    return main(["--config", str(path), *extra])
+
+
+def test_train_refuses_an_unknown_env_kwarg_and_leaves_no_out_dir(tmp_path: Path, capsys):
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    config = tiny_training_config(out_dir)
+    config["env_kwargs"]["transmision_penalty"] = 1.0
+    with pytest.raises(SystemExit):
+        train_main(tmp_path, config)
+    line = _error_line(capsys)
+    assert "env_kwargs" in line and "transmision_penalty" in line, line
+    assert not out_dir.exists()
+
+
+@pytest.mark.parametrize(
+    ("change", "key"),
+    [
+        ({"hyperparameters": {"n_steps": 0}}, "hyperparameters.n_steps"),
+        ({"hyperparameters": {"gamma": "high"}}, "hyperparameters.gamma"),
+        (
+            {"hyperparameters": {"normalize_advantage": "yes"}},
+            "hyperparameters.normalize_advantage",
+        ),
+    ],
+)
+def test_config_refuses_bad_hyperparameters(tmp_path: Path, change, key) -> None:
+    pytest.importorskip("stable_baselines3")
+    from agents.config import config_from_dict
+
+    with pytest.raises(ValueError) as error:
+        config_from_dict(tiny_training_config(tmp_path / "run", **change))
+    assert_one_line(error, key)
+
+
+def test_config_refuses_an_out_dir_under_a_file(tmp_path: Path) -> None:
+    pytest.importorskip("stable_baselines3")
+    from agents.config import config_from_dict
+
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(ValueError) as error:
+        config_from_dict(tiny_training_config(blocker / "run"))
+    assert_one_line(error, "out_dir")
+
+
+def test_train_refuses_init_from_a_model_of_another_env(tmp_path: Path, capsys) -> None:
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    config = tiny_training_config(
+        out_dir,
+        env_id="etsc/InnerFormation-v0",
+        init_from=str(MODELS / "AttitudeTracking-v0_ppo.zip"),
+    )
+    with pytest.raises(SystemExit):
+        train_main(tmp_path, config)
+    line = _error_line(capsys)
+    assert "init_from" in line and "(14,)" in line and "(18,)" in line, line
+    assert not out_dir.exists()
+
+
+def _evaluations(out_dir: Path) -> list[dict]:
+    import json
+
+    return json.loads((out_dir / "evaluations.json").read_text(encoding="utf-8"))
+
+
+def test_resume_keeps_the_evaluation_history(tmp_path: Path) -> None:
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    config = tiny_training_config(out_dir)
+    assert train_main(tmp_path, config) == 0
+    before = _evaluations(out_dir)
+    assert [entry["timesteps"] for entry in before] == [64, 128, 192]
+    assert train_main(tmp_path, config, "--timesteps", "320", "--resume") == 0
+    after = _evaluations(out_dir)
+    assert after[: len(before)] == before
+    assert [entry["timesteps"] for entry in after] == [64, 128, 192, 256, 320]
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        {"seed": 7},
+        {"env_kwargs": {"horizon_s": 0.05, "cost_scale": 0.01, "transmission_penalty": 3.0}},
+        {"hyperparameters": {"n_steps": 64, "batch_size": 64, "n_epochs": 1, "learning_rate": 0.1}},
+    ],
+)
+def test_resume_refuses_checkpoints_of_another_config(tmp_path: Path, capsys, change) -> None:
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    assert train_main(tmp_path, tiny_training_config(out_dir)) == 0
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        train_main(tmp_path, tiny_training_config(out_dir, **change), "--resume")
+    line = _error_line(capsys)
+    assert "another config" in line and next(iter(change)) in line, line
+
+
+def test_a_fresh_run_refuses_an_out_dir_holding_checkpoints(tmp_path: Path, capsys) -> None:
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    assert train_main(tmp_path, tiny_training_config(out_dir)) == 0
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        train_main(tmp_path, tiny_training_config(out_dir, seed=3))
+    assert "--resume" in _error_line(capsys)
+
+
+@pytest.mark.parametrize("damage", ["truncated zip", "missing statistics"])
+def test_resume_falls_back_past_a_torn_checkpoint(tmp_path: Path, capsys, damage) -> None:
+    import json
+
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    config = tiny_training_config(out_dir)
+    assert train_main(tmp_path, config) == 0
+    checkpoints = out_dir / "checkpoints"
+    if damage == "truncated zip":
+        newest = checkpoints / "model_192_steps.zip"
+        newest.write_bytes(newest.read_bytes()[:1000])
+    else:
+        (checkpoints / "model_vecnormalize_192_steps.pkl").unlink()
+    assert train_main(tmp_path, config, "--timesteps", "256", "--resume") == 0
+    assert "skipping model_192_steps.zip" in capsys.readouterr().err
+    summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    assert summary["resumed_from"].endswith("model_128_steps.zip")
+    assert [entry["timesteps"] for entry in _evaluations(out_dir)] == [64, 128, 192, 256]
+
+
+def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> None:
+    """SIGINT mid-run: one line and status 130, no traceback; ``--resume`` then keeps every
+    evaluation up to the checkpoint it continues from."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import yaml
+
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    config = tiny_training_config(out_dir, total_timesteps=1_000_000)
+    config_path = tmp_path / "config.yaml"
+    config_path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    command = [sys.executable, "-m", "agents.train", "--config", str(config_path)]
+    root = Path(__file__).parents[1]
+    process = subprocess.Popen(
+        command, cwd=root, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    evaluations = out_dir / "evaluations.json"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None:
+        if evaluations.is_file() and len(_evaluations(out_dir)) >= 4:
+            break
+        time.sleep(0.2)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    assert "Traceback" not in stderr, stderr
+    assert "--resume" in stderr
+    before = _evaluations(out_dir)
+    assert len(before) >= 4
+
+    newest = max(
+        int(p.stem.split("_")[1]) for p in (out_dir / "checkpoints").glob("model_*_steps.zip")
+    )
+    resumed = subprocess.run(
+        [*command, "--timesteps", str(newest + 128), "--resume"],
+        cwd=root,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ},
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    after = _evaluations(out_dir)
+    kept = [entry for entry in before if entry["timesteps"] <= newest]
+    assert after[: len(kept)] == kept
+    assert [entry["timesteps"] for entry in after] == list(range(64, newest + 129, 64))
