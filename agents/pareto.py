@@ -39,7 +39,7 @@ from matplotlib import ticker
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.evaluation import episode_summary
-from baselines.cli import limit_torch_threads, parse_assignments, write_json
+from baselines.cli import limit_torch_threads, parse_assignments, require_policies, write_json
 from baselines.evaluate import evaluate
 from baselines.plotting import save
 from baselines.triggers.asteroid import PAPER_ALPHA
@@ -154,6 +154,8 @@ def pareto(
                 f"--reuse: that result is of (env, env_kwargs, scenarios, set_size) = "
                 f"{earlier}, not {identity}"
             )
+
+    require_policies(env_id, env_kwargs, [f"sb3:{path}" for path in models])
 
     def point(spec: str, args: dict[str, Any]) -> dict[str, Any]:
         return run_point(env_id, spec, args, env_kwargs, scenarios, set_size)

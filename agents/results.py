@@ -40,7 +40,13 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs
-from baselines.cli import episode_setup, limit_torch_threads, parse_assignments, write_json
+from baselines.cli import (
+    episode_setup,
+    limit_torch_threads,
+    parse_assignments,
+    require_policies,
+    write_json,
+)
 from baselines.evaluate import evaluate
 from baselines.statistics import paired_ratio, seeds_ratio
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
@@ -231,6 +237,7 @@ def compare(
         if name not in SCENARIO_SET_NAMES:
             raise ValueError(f"--scenarios must be among {SCENARIO_SET_NAMES}, got {name!r}")
     env_args = dict(env_args or {})
+    require_policies(env_id, env_args, [f"sb3:{model}" for model in models])
     return {
         "env": env_id,
         "models": list(models),

@@ -126,6 +126,17 @@ def episode_setup(env_id: str, env_args: dict[str, Any]) -> EpisodeSetup:
     return EpisodeSetup(env, lambda spec, args: make_policy(spec, env, args, env_id), run_episode)
 
 
+def require_policies(env_id: str, env_args: dict[str, Any], specs: list[str]) -> None:
+    """Build every policy of ``specs`` once for ``env_id`` (loading each model and checking
+    its spaces), so that a bad model is refused with one line before any long work."""
+    setup = episode_setup(env_id, env_args)
+    try:
+        for spec in specs:
+            setup.make_policy(spec, {})
+    finally:
+        setup.env.close()
+
+
 def _policy_for(
     spec: str,
     observation_space: gym.Space,
