@@ -112,6 +112,11 @@ def verdict(
     cost_high = cost["iqm_ci95"][1] if cost["iqm_ci95"] else None
     if cost_high is None or cost_high > cost_max:
         reasons.append(f"cost ratio upper bound {_number(cost_high)} > {cost_max}")
+    if cost.get("worse_where_reference_zero"):
+        reasons.append(
+            f"a cost above 0 on {cost['worse_where_reference_zero']} scenario(s) where the "
+            "reference's is 0"
+        )
     if transmissions is not None:
         sent_high = transmissions["iqm_ci95"][1] if transmissions["iqm_ci95"] else None
         if sent_high is None or sent_high > TRANSMISSION_RATIO_MAX:

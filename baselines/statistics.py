@@ -112,8 +112,10 @@ def paired_ratio(candidate: Sequence[float], reference: Sequence[float]) -> dict
     Returns the per-scenario ratios' IQM and median (``iqm``, ``iqm_ci95``, ``median``), the
     ratio of the means with its paired interval (``ratio_of_means``,
     ``ratio_of_means_ci95``), and the probability of improvement ``P(candidate < reference)``
-    per scenario (``probability_of_improvement`` and its interval). Scenarios where the
-    reference is 0 leave the per-scenario ratios (``None`` if all do).
+    per scenario (``probability_of_improvement`` and its interval). Where the reference is 0
+    the ratio is 1 if the candidate is 0 too; a scenario where only the reference is 0 has no
+    ratio and is counted in ``worse_where_reference_zero`` (the candidate is worse there,
+    whatever the ratios say). ``iqm`` is ``None`` when no scenario has a ratio.
     """
     a = np.asarray(candidate, dtype=float)
     b = np.asarray(reference, dtype=float)
@@ -126,9 +128,11 @@ def paired_ratio(candidate: Sequence[float], reference: Sequence[float]) -> dict
         "probability_of_improvement": float(_improvement(a, b)),
         "probability_of_improvement_ci95": _bootstrap_interval((a, b), _improvement, True),
     }
-    defined = b != 0.0
+    both_zero = (b == 0.0) & (a == 0.0)
+    defined = (b != 0.0) | both_zero
+    result["worse_where_reference_zero"] = int(np.sum((b == 0.0) & (a != 0.0)))
     if defined.any():
-        ratios = a[defined] / b[defined]
+        ratios = np.where(both_zero, 1.0, a / np.where(b == 0.0, 1.0, b))[defined]
         result.update(
             iqm=float(iqm(ratios)),
             iqm_ci95=_bootstrap_interval((ratios,), iqm),
@@ -136,10 +140,10 @@ def paired_ratio(candidate: Sequence[float], reference: Sequence[float]) -> dict
         )
     else:
         result.update(iqm=None, iqm_ci95=None, median=None)
-    if b.mean() != 0.0:
+    if np.all(b != 0.0):
         result["ratio_of_means"] = float(_ratio_of_means(a, b))
         result["ratio_of_means_ci95"] = _bootstrap_interval((a, b), _ratio_of_means, True)
-    else:
+    else:  # a resample of the zero references alone has no ratio of means
         result["ratio_of_means"] = result["ratio_of_means_ci95"] = None
     return result
 
@@ -153,16 +157,20 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
 
     Returns the IQM over runs × scenarios of the per-scenario ratios with rliable's
     stratified bootstrap interval (``iqm``, ``iqm_ci95``), each run's own IQM (``per_run``)
-    and their range.
+    and their range. Zero references follow :func:`paired_ratio`: 0 / 0 is 1, and a scenario
+    where a run is above a zero reference leaves the ratios and is counted in
+    ``worse_where_reference_zero``.
     """
     from rliable import library as rly
     from rliable import metrics
 
     a = np.atleast_2d(np.asarray(candidate, dtype=float))
     b = np.broadcast_to(np.asarray(reference, dtype=float), a.shape)
-    if np.any(b == 0.0):
-        raise ValueError("reference must be non-zero on every scenario to form ratios")
-    ratios = a / b
+    worse = np.any((b == 0.0) & (a != 0.0), axis=0)
+    if worse.all():
+        raise ValueError("no scenario has a ratio: the reference is 0 wherever a run is not")
+    kept_a, kept_b = a[:, ~worse], b[:, ~worse]
+    ratios = np.where(kept_b == 0.0, 1.0, kept_a / np.where(kept_b == 0.0, 1.0, kept_b))
     point, interval = rly.get_interval_estimates(
         {"ratio": ratios},
         lambda scores: np.array([metrics.aggregate_iqm(scores)]),
@@ -178,6 +186,7 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
         "iqm_ci95": [float(interval["ratio"][0, 0]), float(interval["ratio"][1, 0])],
         "per_run": per_run,
         "range": [min(per_run), max(per_run)],
+        "worse_where_reference_zero": int(worse.sum()),
     }
 
 

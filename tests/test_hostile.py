@@ -373,6 +373,7 @@ def tiny_training_config(out_dir: Path, **changes) -> dict:
         "tensorboard": False,
         "checkpoint_every": 64,
         "evaluation_every": 64,
+        "evaluation_scenarios": 2,
         "evaluation_env_kwargs": {"horizon_s": 0.05},
     }
     config.update(changes)
