@@ -536,7 +536,13 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
     command = [sys.executable, "-m", "agents.train", "--config", str(config_path)]
     root = Path(__file__).parents[1]
     process = subprocess.Popen(
-        command, cwd=root, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        command,
+        cwd=root,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        # a test run started in the background inherits SIGINT ignored; the run must not
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     evaluations = out_dir / "evaluations.json"
     deadline = time.monotonic() + 120
