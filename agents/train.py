@@ -21,6 +21,7 @@ import importlib.util
 import json
 import time
 from collections import deque
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -80,9 +81,12 @@ def _plain(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def train(config: TrainConfig, resume: bool = False) -> Path:
+def train(
+    config: TrainConfig, resume: bool = False, callbacks: Sequence[BaseCallback] = ()
+) -> Path:
     """Train the configured model (from the newest checkpoint if ``resume``), write the output
-    files and return the output folder."""
+    files and return the output folder. ``callbacks`` run after the run's own (episode
+    metrics, checkpoints, evaluations), e.g. to report progress to a tuner."""
     torch.set_num_threads(config.torch_threads)
     out_dir = Path(config.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -119,7 +123,7 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
     periodic = _periodic_callbacks(config, out_dir, env.num_envs)
     model.learn(
         total_timesteps=max(config.total_timesteps - model.num_timesteps, 0),
-        callback=CallbackList([metrics_callback, *periodic]),
+        callback=CallbackList([metrics_callback, *periodic, *callbacks]),
         progress_bar=_progress_bar_available(),
         reset_num_timesteps=checkpoint is None,
     )
