@@ -1,7 +1,8 @@
 """Accuracy against transmissions: the paper's trigger, periodic sampling and learned triggers.
 
-    python -m agents.pareto ENV_ID [--model PATH ...] [--env-arg k=v ...] [--seed S]
-                                   [--out DIR] [--reuse PARETO_JSON]
+    python -m agents.pareto ENV_ID [--model PATH ...] [--sweep RESULTS_DIR ...]
+                                   [--env-arg k=v ...] [--seed S] [--out DIR]
+                                   [--reuse PARETO_JSON]
 
 Runs one episode of the paper scenario (``randomize`` off) for every point of three curves and
 plots ``mean_cost`` (the per-step accuracy cost the reward penalises) against the number of
@@ -11,7 +12,8 @@ transmissions:
   γ2 for 000, c for 001, α for 003, Π for 004), the paper's own value included;
 * periodic transmission every ``k`` sampling instants (:func:`periodic_sweep`);
 * each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
-  typically one per transmission penalty λ.
+  typically one per transmission penalty λ, and the model of every finished trial of each
+  ``--sweep`` (the results folder of ``python -m agents.sweep``: a front in one option).
 
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
 ``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper and periodic curves of
@@ -29,6 +31,7 @@ import matplotlib.pyplot as plt
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.evaluation import episode_summary
+from agents.sweep_results import sweep_models
 from baselines.cli import EpisodeSetup, episode_setup, limit_torch_threads, parse_assignments
 from baselines.plotting import save
 from baselines.triggers.asteroid import PAPER_ALPHA
@@ -182,6 +185,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--model", action="append", default=[], help="an SB3 zip of a learned trigger (repeatable)"
     )
+    parser.add_argument(
+        "--sweep",
+        action="append",
+        default=[],
+        metavar="RESULTS_DIR",
+        help="add the model of every finished trial of a sweep (agents.sweep; repeatable)",
+    )
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
     parser.add_argument("--seed", type=int, default=0, help="reset seed of every episode")
     parser.add_argument("--out", type=Path, help="output folder")
@@ -196,7 +206,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         env_kwargs = parse_assignments(args.env_arg, "--env-arg")
         reuse = json.loads(args.reuse.read_text(encoding="utf-8")) if args.reuse else None
-        result = pareto(args.env_id, args.model, env_kwargs, args.seed, reuse)
+        models = args.model + sweep_models(args.sweep, args.env_id)
+        result = pareto(args.env_id, models, env_kwargs, args.seed, reuse)
     except ValueError as error:
         parser.error(str(error))
     out_dir = args.out or Path("results") / "pareto" / args.env_id.split("/")[-1]

@@ -1,8 +1,8 @@
 """A learned trigger against the paper's trigger and periodic sampling: the rows of
 ``docs/results.md``.
 
-    python -m agents.results ENV_ID --model PATH [--randomized-episodes K] [--env-arg k=v ...]
-                                    [--out DIR]
+    python -m agents.results ENV_ID (--model PATH | --sweep RESULTS_DIR)
+                                    [--randomized-episodes K] [--env-arg k=v ...] [--out DIR]
 
 On the paper scenario (``randomize`` off, seed 0) it runs the paper's trigger, the learned
 model and periodic transmission at the learned model's rate (every ``k`` sampling instants on
@@ -15,7 +15,8 @@ metrics (:data:`PAPER_KEYS`), and it judges the goal: ``mean_cost`` at most
 fewer transmissions.
 
 Writes ``results.json`` into ``DIR`` (default ``results/<env name>``) and prints the table as
-Markdown.
+Markdown. With ``--sweep`` (the results folder of ``python -m agents.sweep``) it compares the
+model of every finished trial, each into ``DIR/<trial name>/results.json``.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import etsc_envs
+from agents.sweep_results import finished_trials
 from baselines.cli import episode_setup, limit_torch_threads, parse_assignments
 from baselines.episodes import to_jsonable
 from baselines.evaluate import evaluate
@@ -189,7 +191,14 @@ def main(argv: list[str] | None = None) -> int:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("env_id", help="a Gymnasium or PettingZoo id of etsc-envs")
-    parser.add_argument("--model", required=True, help="the SB3 zip of the learned trigger")
+    learned = parser.add_mutually_exclusive_group(required=True)
+    learned.add_argument("--model", help="the SB3 zip of the learned trigger")
+    learned.add_argument(
+        "--sweep",
+        metavar="RESULTS_DIR",
+        help="compare the model of every finished trial of a sweep (agents.sweep), each "
+        "written to DIR/<trial name>/results.json",
+    )
     parser.add_argument("--randomized-episodes", type=int, default=5, metavar="K")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
     parser.add_argument("--out", help="output folder (default results/<env name>)")
@@ -197,20 +206,26 @@ def main(argv: list[str] | None = None) -> int:
     limit_torch_threads()
     if args.randomized_episodes < 0:
         parser.error(f"--randomized-episodes must be >= 0, got {args.randomized_episodes}")
+    out_dir = Path(args.out or Path("results") / args.env_id.split("/")[-1])
     try:
-        result = compare(
-            args.env_id,
-            args.model,
-            parse_assignments(args.env_arg, "--env-arg"),
-            args.randomized_episodes,
-        )
+        models = {out_dir: args.model}
+        if args.sweep is not None:
+            models = {
+                out_dir / trial.name: str(trial.model)
+                for trial in finished_trials(args.sweep, args.env_id)
+            }
+        env_args = parse_assignments(args.env_arg, "--env-arg")
+        results = {
+            folder: compare(args.env_id, model, env_args, args.randomized_episodes)
+            for folder, model in models.items()
+        }
     except (ValueError, TypeError) as error:
         parser.error(str(error))
-    out_dir = Path(args.out or Path("results") / args.env_id.split("/")[-1])
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "results.json").write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
-    print(markdown(result))
-    print(f"wrote {out_dir / 'results.json'}")
+    for folder, result in results.items():
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "results.json").write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+        print(markdown(result))
+        print(f"wrote {folder / 'results.json'}")
     return 0
 
 

@@ -76,7 +76,9 @@ def connect(address: str | None) -> None:
     try:
         ray.init(address=address, log_to_driver=True)
     except ConnectionError as error:
-        raise ValueError(f"--address: cannot join the Ray cluster at {address!r}: {error}") from None
+        raise ValueError(
+            f"--address: cannot join the Ray cluster at {address!r}: {error}"
+        ) from None
 
 
 def build_tuner(sweep: SweepConfig, resume: bool) -> Any:
@@ -128,7 +130,9 @@ def _scheduler(sweep: SweepConfig) -> Any:
 
     grace = sweep.grace_timesteps or max(sweep.total_timesteps // 10, 1)
     return ASHAScheduler(
-        time_attr="timesteps", max_t=sweep.total_timesteps, grace_period=min(grace, sweep.total_timesteps)
+        time_attr="timesteps",
+        max_t=sweep.total_timesteps,
+        grace_period=min(grace, sweep.total_timesteps),
     )
 
 
@@ -143,15 +147,19 @@ def _search_algorithm(sweep: SweepConfig) -> Any:
 def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
     """Every trial of Tune's ``ResultGrid`` as the summary records it, in Tune's order (the
     grid's)."""
+    grid_values = {sweep.trial_name(point): point for point in sweep.grid_points()}
     trials = []
     for result in results:
         name = Path(result.path).name
         folder = sweep.trial_folder(name)
         error = None if result.error is None else _one_line(result.error)
+        # A trial that never reported has no config in its result: a grid point's values
+        # follow from its name; a search trial's were not drawn yet.
+        values = result.config or grid_values.get(name, {})
         trials.append(
             SweepTrial(
                 name=name,
-                values={key: result.config.get(key) for key in sweep.swept_keys},
+                values={key: values[key] for key in sweep.swept_keys if key in values},
                 status=trial_status(folder, error),
                 error=error,
                 folder=folder,

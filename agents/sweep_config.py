@@ -123,7 +123,8 @@ class SweepConfig:
     def grid_points(self) -> list[dict[str, Any]]:
         """Every combination of the grid's values, in the config's order."""
         keys = list(self.grid)
-        return [dict(zip(keys, values)) for values in itertools.product(*self.grid.values())]
+        combinations = itertools.product(*self.grid.values())
+        return [dict(zip(keys, values, strict=True)) for values in combinations]
 
     def trial_name(self, values: Mapping[str, Any], trial_id: str | None = None) -> str:
         """A trial's folder name: its swept values as ``key=value`` joined by commas (the last
@@ -229,7 +230,8 @@ def format_value(value: Any) -> str:
 def _labels(keys: list[str]) -> dict[str, str]:
     """Each key's last dotted part, or the whole key where two keys share that part."""
     last = [key.rpartition(".")[2] for key in keys]
-    return {key: key if last.count(part) > 1 else part for key, part in zip(keys, last)}
+    pairs = zip(keys, last, strict=True)
+    return {key: key if last.count(part) > 1 else part for key, part in pairs}
 
 
 def _assign(raw: dict[str, Any], key: str, value: Any) -> None:
@@ -249,7 +251,9 @@ def _check_key_set(raw: Mapping[str, Any]) -> None:
         raise ValueError(f"unknown sweep key(s) {unknown}; allowed keys: {list(allowed)}")
     missing = [key for key in REQUIRED_SWEEP_KEYS if key not in raw]
     if missing:
-        raise ValueError(f"missing sweep key(s) {missing}; required keys: {list(REQUIRED_SWEEP_KEYS)}")
+        raise ValueError(
+            f"missing sweep key(s) {missing}; required keys: {list(REQUIRED_SWEEP_KEYS)}"
+        )
 
 
 def _check_training_key(section: str, key: Any) -> str:
@@ -272,7 +276,9 @@ def _load_base(value: Any) -> dict[str, Any]:
         with open(path, encoding="utf-8") as stream:
             raw = yaml.safe_load(stream)
     except OSError as error:
-        raise ValueError(f"sweep key 'base': cannot read {str(path)!r} ({error.strerror})") from None
+        raise ValueError(
+            f"sweep key 'base': cannot read {str(path)!r} ({error.strerror})"
+        ) from None
     if not isinstance(raw, dict):
         raise ValueError(f"sweep key 'base': {str(path)!r} is not a YAML mapping of keys to values")
     return raw
@@ -314,7 +320,7 @@ def _check_search(value: Any) -> dict[str, dict[str, list[Any]]]:
                 f"{{loguniform: [low, high]}}, {{randint: [low, high]}}, {{choice: [values]}}; "
                 f"got {spec!r}"
             )
-        (distribution, arguments), = spec.items()
+        ((distribution, arguments),) = spec.items()
         _check_distribution(f"search.{key}.{distribution}", distribution, arguments)
     return search
 
@@ -332,7 +338,9 @@ def _check_distribution(key: str, distribution: str, arguments: Any) -> None:
     if distribution == "randint":
         numbers = numbers and all(isinstance(x, int) for x in arguments)
     if not numbers or not arguments[0] < arguments[1]:
-        raise ValueError(f"sweep key {key!r} must be [low, high] with low < high, got {arguments!r}")
+        raise ValueError(
+            f"sweep key {key!r} must be [low, high] with low < high, got {arguments!r}"
+        )
     if distribution == "loguniform" and arguments[0] <= 0:
         raise ValueError(f"sweep key {key!r} needs low > 0, got {arguments!r}")
 
@@ -422,5 +430,6 @@ def _check_trial_configs(config: SweepConfig) -> None:
 
 
 def _first_value(spec: dict[str, list[Any]]) -> Any:
-    (distribution, arguments), = spec.items()
+    """A distribution's lower bound, or a choice's first value."""
+    (arguments,) = spec.values()
     return arguments[0]

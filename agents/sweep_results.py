@@ -125,9 +125,7 @@ def trial_status(folder: Path, error: str | None) -> str:
     return "finished" if (folder / MODEL_FILE).is_file() else "incomplete"
 
 
-def write_summary(
-    results_dir: str | Path, sweep: dict[str, Any], trials: list[SweepTrial]
-) -> Path:
+def write_summary(results_dir: str | Path, sweep: dict[str, Any], trials: list[SweepTrial]) -> Path:
     """Write ``sweep_summary.json`` (whole or not at all): the sweep's description and every
     trial's record, with the count of trials in each status."""
     results_dir = Path(results_dir)
@@ -180,3 +178,12 @@ def finished_trials(results_dir: str | Path, env_id: str) -> list[SweepTrial]:
     if not finished:
         raise ValueError(f"--sweep: {str(results_dir)!r} has no finished trial")
     return finished
+
+
+def sweep_models(results_dirs: list[str | Path], env_id: str) -> list[str]:
+    """The model paths of the finished trials of every sweep in ``results_dirs``."""
+    return [
+        str(trial.model)
+        for results_dir in results_dirs
+        for trial in finished_trials(results_dir, env_id)
+    ]
