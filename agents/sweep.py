@@ -146,7 +146,7 @@ def _search_algorithm(sweep: SweepConfig) -> Any:
 
 def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
     """Every trial of Tune's ``ResultGrid`` as the summary records it, in Tune's order (the
-    grid's)."""
+    grid's), and, for a grid, the points that Tune had not started when it was interrupted."""
     grid_values = {sweep.trial_name(point): point for point in sweep.grid_points()}
     trials = []
     for result in results:
@@ -166,6 +166,13 @@ def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
                 scores=final_scores(folder) if error is None else None,
             )
         )
+    if not sweep.search:  # grid points that Tune had not created when it was interrupted
+        started = {trial.name for trial in trials}
+        trials += [
+            SweepTrial(name, values, "incomplete", None, sweep.trial_folder(name), None)
+            for name, values in grid_values.items()
+            if name not in started
+        ]
     return trials
 
 
@@ -183,7 +190,7 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
 
     if resume and not tune.Tuner.can_restore(str(sweep.tune_dir)):
         raise ValueError(f"--resume: no saved sweep in {str(sweep.tune_dir)!r} to continue")
-    if not resume and sweep.tune_dir.exists():
+    if not resume and (sweep.tune_dir.exists() or sweep.trials_dir.exists()):
         raise ValueError(
             f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
             f"or choose another results_dir"

@@ -137,9 +137,14 @@ class SweepConfig:
             parts.append(f"trial={trial_id}")
         return ",".join(parts) or "trial"
 
+    @property
+    def trials_dir(self) -> Path:
+        """The folder of the trials' folders."""
+        return Path(self.results_dir) / TRIALS_DIR
+
     def trial_folder(self, name: str) -> Path:
         """Where the trial called ``name`` writes its training outputs."""
-        return Path(self.results_dir) / TRIALS_DIR / name
+        return self.trials_dir / name
 
     def trial_config(self, values: Mapping[str, Any], out_dir: str | Path) -> TrainConfig:
         """The validated training config of the trial with the swept ``values``."""
@@ -423,7 +428,7 @@ def _check_trial_configs(config: SweepConfig) -> None:
     for point in config.grid_points():
         values = {**point, **sample}
         try:
-            config.trial_config(values, Path(config.results_dir) / TRIALS_DIR)
+            config.trial_config(values, config.trials_dir)
         except ValueError as error:
             where = config.trial_name(values) if values else "the base config"
             raise ValueError(f"{config.path}: trial {where}: {error}") from None

@@ -117,12 +117,19 @@ class SweepTrial:
         }
 
 
+def training_finished(folder: str | Path) -> bool:
+    """Whether the training run in ``folder`` finished: ``agents.train`` writes its summary
+    last, after the model."""
+    folder = Path(folder)
+    return (folder / MODEL_FILE).is_file() and (folder / TRAIN_SUMMARY_FILE).is_file()
+
+
 def trial_status(folder: Path, error: str | None) -> str:
-    """``failed`` if the trial raised, else ``finished`` if its model was saved, else
+    """``failed`` if the trial raised, else ``finished`` if its training finished, else
     ``incomplete``."""
     if error is not None:
         return "failed"
-    return "finished" if (folder / MODEL_FILE).is_file() else "incomplete"
+    return "finished" if training_finished(folder) else "incomplete"
 
 
 def write_summary(results_dir: str | Path, sweep: dict[str, Any], trials: list[SweepTrial]) -> Path:

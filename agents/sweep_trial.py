@@ -2,8 +2,10 @@
 progress to Tune.
 
 The trial's folder is ``results_dir/trials/<name>`` (:meth:`SweepConfig.trial_name`). A trial
-that Tune restarts after an interruption continues from the newest checkpoint in that folder
-when the training config saves checkpoints, else it starts again.
+that Tune restarts after an interruption does not train again if its training had finished
+(an interruption can land between the saved model and Tune's record of the trial's end); else
+it continues from the newest checkpoint in that folder when the training config saves
+checkpoints, or starts again.
 """
 
 from __future__ import annotations
@@ -16,7 +18,13 @@ from ray import tune
 from stable_baselines3.common.callbacks import BaseCallback
 
 from agents.sweep_config import SweepConfig
-from agents.sweep_results import EVALUATIONS_FILE, final_scores, last_evaluation, scores
+from agents.sweep_results import (
+    EVALUATIONS_FILE,
+    final_scores,
+    last_evaluation,
+    scores,
+    training_finished,
+)
 from agents.train import CHECKPOINT_DIR, latest_checkpoint, train
 
 
@@ -46,9 +54,10 @@ def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
     it goes, and report the final scores once the model is saved."""
     name = sweep.trial_name(values, tune.get_context().get_trial_id())
     folder = sweep.trial_folder(name)
-    config = sweep.trial_config(values, folder)
-    resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
-    train(config, resume=resume, callbacks=[TuneReportCallback(folder)])
+    if not training_finished(folder):
+        config = sweep.trial_config(values, folder)
+        resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
+        train(config, resume=resume, callbacks=[TuneReportCallback(folder)])
     tune.report(final_scores(folder))
 
 
