@@ -147,7 +147,9 @@ def _search_algorithm(sweep: SweepConfig) -> Any:
 def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
     """Every trial of Tune's ``ResultGrid`` as the summary records it, in Tune's order (the
     grid's), and, for a grid, the points that Tune had not started when it was interrupted."""
-    grid_values = {sweep.trial_name(point): point for point in sweep.grid_points()}
+    grid_values = {}
+    if not sweep.search:
+        grid_values = {sweep.trial_name(point): point for point in sweep.grid_points()}
     trials = []
     for result in results:
         name = Path(result.path).name
@@ -166,7 +168,7 @@ def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
                 scores=final_scores(folder) if error is None else None,
             )
         )
-    if not sweep.search:  # grid points that Tune had not created when it was interrupted
+    if grid_values:  # grid points that Tune had not created when it was interrupted
         started = {trial.name for trial in trials}
         trials += [
             SweepTrial(name, values, "incomplete", None, sweep.trial_folder(name), None)
@@ -177,10 +179,11 @@ def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
 
 
 def _one_line(error: BaseException) -> str:
-    """A trial's error as ``Type: message``, the underlying exception's when Ray wraps it."""
+    """A trial's error as ``Type: first line of its message``, the underlying exception's when
+    Ray wraps it."""
     cause = getattr(error, "cause", None) or error
-    message = str(cause).strip().splitlines()
-    return f"{type(cause).__name__}: {message[-1] if message else ''}".rstrip(": ")
+    lines = str(cause).strip().splitlines()
+    return f"{type(cause).__name__}: {lines[0]}" if lines else type(cause).__name__
 
 
 def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[SweepTrial]:

@@ -29,18 +29,25 @@ from agents.train import CHECKPOINT_DIR, latest_checkpoint, train
 
 
 class TuneReportCallback(BaseCallback):
-    """After every rollout, report to Tune the training steps, the mean return of the recent
-    training episodes and the training run's last evaluation against the paper trigger
-    (read from its ``evaluations.json``; see :func:`agents.sweep_results.scores`)."""
+    """After every rollout but the last, report to Tune the training steps, the mean return of
+    the recent training episodes and the training run's last evaluation against the paper
+    trigger (read from its ``evaluations.json``; see :func:`agents.sweep_results.scores`).
 
-    def __init__(self, run_folder: str | Path) -> None:
+    The last rollout (``total_timesteps`` reached) reports nothing: a scheduler stops a trial
+    that reports its full length, which would end it before its model is saved; the trial
+    reports its final scores after training instead."""
+
+    def __init__(self, run_folder: str | Path, total_timesteps: int) -> None:
         super().__init__()
         self.run_folder = Path(run_folder)
+        self.total_timesteps = total_timesteps
 
     def _on_step(self) -> bool:
         return True
 
     def _on_rollout_end(self) -> None:
+        if self.num_timesteps >= self.total_timesteps:
+            return
         episodes = self.model.ep_info_buffer
         reward = float(np.mean([episode["r"] for episode in episodes])) if episodes else None
         evaluation = None
@@ -57,7 +64,8 @@ def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
     if not training_finished(folder):
         config = sweep.trial_config(values, folder)
         resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
-        train(config, resume=resume, callbacks=[TuneReportCallback(folder)])
+        reporter = TuneReportCallback(folder, config.total_timesteps)
+        train(config, resume=resume, callbacks=[reporter])
     tune.report(final_scores(folder))
 
 

@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import pytest
@@ -40,7 +41,7 @@ def tiny_sweep(tmp_path: Path, **keys: Any) -> Path:
     raw["results_dir"] = str(tmp_path / "sweep")
     raw.update(keys)
     path = tmp_path / "sweep.yaml"
-    path.write_text(yaml.safe_dump(raw), encoding="utf-8")
+    path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
     return path
 
 
@@ -191,3 +192,59 @@ def test_a_bad_sweep_config_exits_with_one_line(tmp_path: Path, capsys) -> None:
     assert (
         "'grid.env_kwargs.transmission_penalty' must be a non-empty list" in capsys.readouterr().err
     )
+
+
+def test_a_search_runs_under_asha_and_optuna_to_saved_models(tmp_path: Path) -> None:
+    search = {
+        "hyperparameters.learning_rate": {"loguniform": [1.0e-4, 1.0e-3]},
+        "env_kwargs.transmission_penalty": {"choice": [30.0, 100.0]},
+    }
+    objective = {"scheduler": "asha", "search_algorithm": "optuna", "metric": "cost_ratio"}
+    keys = {"kind": "search", "grid": {}, "search": search, "num_samples": 2, **objective}
+    config = tiny_sweep(tmp_path, **keys, mode="min", grace_timesteps=1024)
+    assert main(["--config", str(config)]) == 0
+    summary = json.loads((tmp_path / "sweep" / "sweep_summary.json").read_text(encoding="utf-8"))
+    assert summary["kind"] == "search" and summary["counts"]["finished"] == 2
+    for trial in summary["trials"]:
+        assert set(trial["values"]) == set(search)
+        assert 1.0e-4 <= trial["values"]["hyperparameters.learning_rate"] <= 1.0e-3
+        assert trial["name"].startswith("learning_rate=") and ",trial=" in trial["name"]
+        assert (tmp_path / "sweep" / trial["folder"] / "model.zip").is_file()
+
+
+def test_the_last_rollout_is_left_to_the_final_report(monkeypatch, tmp_path: Path) -> None:
+    """A scheduler stops a trial that reports its full length: that report must come after
+    the model is saved, not from the training loop."""
+    import agents.sweep_trial as sweep_trial
+
+    reports: list[dict[str, Any]] = []
+    monkeypatch.setattr(sweep_trial.tune, "report", reports.append)
+    callback = sweep_trial.TuneReportCallback(tmp_path, total_timesteps=2048)
+    callback.model = SimpleNamespace(ep_info_buffer=[{"r": -2.0}, {"r": -4.0}])
+    for timesteps in (1024, 2048):
+        callback.num_timesteps = timesteps
+        callback.on_rollout_end()
+    assert reports == [{"timesteps": 1024, "training_reward": -3.0}]
+
+
+def test_a_summary_names_the_grid_points_that_never_started(tmp_path: Path) -> None:
+    from agents.sweep import summarize
+    from agents.sweep_config import load_sweep_config
+
+    config = load_sweep_config(tiny_sweep(tmp_path))
+    wrapped = RuntimeError("task failed\nTraceback ...")
+    wrapped.cause = ValueError("transmission_penalty must be >= 0\n  in the env")
+    results = [
+        SimpleNamespace(
+            path=str(tmp_path / "tune" / "transmission_penalty=30"),
+            config={"env_kwargs.transmission_penalty": 30.0},
+            error=wrapped,
+        )
+    ]
+    trials = summarize(config, results)
+    assert [(trial.name, trial.status) for trial in trials] == [
+        ("transmission_penalty=30", "failed"),
+        ("transmission_penalty=100", "incomplete"),
+    ]
+    assert trials[0].error == "ValueError: transmission_penalty must be >= 0"
+    assert trials[1].values == {"env_kwargs.transmission_penalty": 100.0}
