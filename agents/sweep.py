@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import json
 import os
 import socket
 import sys
@@ -35,8 +36,14 @@ from urllib.parse import urlsplit
 import yaml
 
 from agents.sweep_config import SweepConfig, load_sweep_config
-from agents.sweep_results import SweepTrial, final_scores, trial_status, write_summary
-from etsc_envs.core.files import require_writable_folder
+from agents.sweep_results import (
+    SETTINGS_FILE,
+    SweepTrial,
+    final_scores,
+    trial_status,
+    write_summary,
+)
+from etsc_envs.core.files import atomic_write_text, require_writable_folder
 
 CONNECT_TIMEOUT_S = 5.0
 """How long the command waits for a Ray address to accept a connection."""
@@ -198,6 +205,10 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
             f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
             f"or choose another results_dir"
         )
+    if resume:
+        _check_unchanged(sweep)
+    else:
+        atomic_write_text(Path(sweep.results_dir) / SETTINGS_FILE, _settings_json(sweep))
     connect(address)
     try:
         results = build_tuner(sweep, resume).fit()
@@ -206,6 +217,26 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
     trials = summarize(sweep, results)
     write_summary(sweep.results_dir, _description(sweep), trials)
     return trials
+
+
+def _settings_json(sweep: SweepConfig) -> str:
+    return json.dumps(sweep.settings(), indent=2, sort_keys=True) + "\n"
+
+
+def _check_unchanged(sweep: SweepConfig) -> None:
+    """``ValueError`` if the sweep's settings differ from those it started with (Tune resumes
+    the trials it planned then; changed settings would mislabel them)."""
+    path = Path(sweep.results_dir) / SETTINGS_FILE
+    if not path.is_file():
+        return
+    started = json.loads(path.read_text(encoding="utf-8"))
+    now = json.loads(_settings_json(sweep))
+    changed = sorted(key for key in {*started, *now} if started.get(key) != now.get(key))
+    if changed:
+        raise ValueError(
+            f"--resume: the sweep's {changed} changed since it started (see {str(path)!r}); "
+            f"resume it with the settings it started with, or start another results_dir"
+        )
 
 
 def _description(sweep: SweepConfig) -> dict[str, Any]:

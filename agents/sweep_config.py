@@ -105,6 +105,12 @@ class SweepConfig:
     cpus_per_trial: float
     max_concurrent_trials: int | None
 
+    def settings(self) -> dict[str, Any]:
+        """Every setting of the sweep (not the path of its YAML), as JSON-ready data."""
+        settings = dataclasses.asdict(self)
+        del settings["path"]
+        return settings
+
     @property
     def swept_keys(self) -> list[str]:
         """The keys that vary between trials, grid first, in the config's order."""

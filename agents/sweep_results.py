@@ -4,6 +4,8 @@ finished trials back (for ``agents.pareto`` and ``agents.results``). No Ray here
 Layout of a sweep's ``results_dir`` (see :mod:`agents.sweep_config`)::
 
     sweep_summary.json          every trial: name, swept values, status, error, final scores
+    sweep_settings.json         the validated sweep config it started with (``--resume``
+                                refuses changed settings)
     trials/<name>/              one ``agents.train`` run: model.zip, model_vecnormalize.pkl,
                                 config.yaml, evaluations.json, train_summary.json, ...
     tune/                       Ray Tune's experiment state (what ``--resume`` restores)
@@ -24,6 +26,7 @@ import numpy as np
 from etsc_envs.core.files import atomic_write_text
 
 SUMMARY_FILE = "sweep_summary.json"
+SETTINGS_FILE = "sweep_settings.json"
 TRIALS_DIR = "trials"
 MODEL_FILE = "model.zip"
 EVALUATIONS_FILE = "evaluations.json"

@@ -248,3 +248,14 @@ def test_a_summary_names_the_grid_points_that_never_started(tmp_path: Path) -> N
     ]
     assert trials[0].error == "ValueError: transmission_penalty must be >= 0"
     assert trials[1].values == {"env_kwargs.transmission_penalty": 100.0}
+
+
+def test_resuming_with_changed_settings_is_refused(interrupted_sweep, tmp_path: Path, capsys):
+    raw = yaml.safe_load(interrupted_sweep["config"].read_text(encoding="utf-8"))
+    raw["overrides"]["total_timesteps"] = 4096
+    changed = tmp_path / "changed.yaml"
+    changed.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--config", str(changed), "--resume"])
+    assert exit_info.value.code == 2
+    assert "--resume: the sweep's ['base'] changed since it started" in capsys.readouterr().err
