@@ -25,7 +25,8 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
   ``OptunaSearch`` (then ``grid`` must be empty); search only;
 * ``metric: null``, ``mode: null`` — the reported metric (:data:`agents.sweep_results.METRICS`)
   that the scheduler or search algorithm optimises, and ``min`` or ``max``; required with
-  either of them;
+  either of them. A trial reports to Tune only once it has that metric (the evaluation
+  metrics need ``evaluation_every``);
 * ``cpus_per_trial: 1`` — CPU cores each trial reserves on the Ray cluster, so a 2-core
   machine runs two trials at a time and a cluster as many as it has cores;
 * ``max_concurrent_trials: null`` — at most this many trials at once (null: as many as the
@@ -53,7 +54,7 @@ from typing import Any
 import yaml
 
 from agents.config import OPTIONAL_DEFAULTS, REQUIRED_KEYS, TrainConfig, config_from_dict
-from agents.sweep_results import METRICS, TRIALS_DIR
+from agents.sweep_results import EVALUATION_METRICS, METRICS, TRIALS_DIR
 
 KINDS = ("front", "search")
 SCHEDULERS = ("asha",)
@@ -434,10 +435,16 @@ def _check_trial_configs(config: SweepConfig) -> None:
     for point in config.grid_points():
         values = {**point, **sample}
         try:
-            config.trial_config(values, config.trials_dir)
+            trial = config.trial_config(values, config.trials_dir)
         except ValueError as error:
             where = config.trial_name(values) if values else "the base config"
             raise ValueError(f"{config.path}: trial {where}: {error}") from None
+        if config.metric in EVALUATION_METRICS and not trial.evaluation_every:
+            raise ValueError(
+                f"sweep key 'metric': {config.metric!r} comes from the training run's "
+                f"evaluations, and evaluation_every is 0; set it in the base config or "
+                f"'overrides'"
+            )
 
 
 def _first_value(spec: dict[str, list[Any]]) -> Any:

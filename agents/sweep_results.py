@@ -49,6 +49,9 @@ training steps, the mean return of the last training episodes, the last evaluati
 ``mean_cost`` and transmissions of the learned policy and of the paper trigger, and their
 ratios learned / paper (absent where the paper's value is 0)."""
 
+EVALUATION_METRICS = METRICS[2:]
+"""The metrics that come from the training run's evaluations against the paper trigger."""
+
 
 def scores(
     timesteps: int, training_reward: float | None, evaluation: dict[str, Any] | None

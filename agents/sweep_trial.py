@@ -35,12 +35,17 @@ class TuneReportCallback(BaseCallback):
 
     The last rollout (``total_timesteps`` reached) reports nothing: a scheduler stops a trial
     that reports its full length, which would end it before its model is saved; the trial
-    reports its final scores after training instead."""
+    reports its final scores after training instead. Nor does a rollout whose scores lack the
+    ``metric`` that the sweep's scheduler or search optimises (Tune refuses such a report),
+    e.g. before the first evaluation."""
 
-    def __init__(self, run_folder: str | Path, total_timesteps: int) -> None:
+    def __init__(
+        self, run_folder: str | Path, total_timesteps: int, metric: str | None = None
+    ) -> None:
         super().__init__()
         self.run_folder = Path(run_folder)
         self.total_timesteps = total_timesteps
+        self.metric = metric
 
     def _on_step(self) -> bool:
         return True
@@ -53,7 +58,9 @@ class TuneReportCallback(BaseCallback):
         evaluation = None
         if (self.run_folder / EVALUATIONS_FILE).is_file():
             evaluation = last_evaluation(self.run_folder)
-        tune.report(scores(self.num_timesteps, reward, evaluation))
+        reported = scores(self.num_timesteps, reward, evaluation)
+        if self.metric is None or self.metric in reported:
+            tune.report(reported)
 
 
 def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
@@ -64,7 +71,7 @@ def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
     if not training_finished(folder):
         config = sweep.trial_config(values, folder)
         resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
-        reporter = TuneReportCallback(folder, config.total_timesteps)
+        reporter = TuneReportCallback(folder, config.total_timesteps, sweep.metric)
         train(config, resume=resume, callbacks=[reporter])
     tune.report(final_scores(folder))
 

@@ -225,6 +225,19 @@ def test_the_last_rollout_is_left_to_the_final_report(monkeypatch, tmp_path: Pat
         callback.num_timesteps = timesteps
         callback.on_rollout_end()
     assert reports == [{"timesteps": 1024, "training_reward": -3.0}]
+    reports.clear()
+    waiting = sweep_trial.TuneReportCallback(tmp_path, total_timesteps=4096, metric="cost_ratio")
+    waiting.model = callback.model
+    waiting.num_timesteps = 1024
+    waiting.on_rollout_end()
+    assert reports == [], "no report before the first evaluation gives the objective"
+    evaluation = {"mean_cost": 2.0, "transmissions": 10, "failure": None}
+    paper = {"mean_cost": 1.0, "transmissions": 20, "failure": None}
+    entry = {"timesteps": 2048, "learned": evaluation, "paper": paper}
+    (tmp_path / "evaluations.json").write_text(json.dumps([entry]), encoding="utf-8")
+    waiting.num_timesteps = 2048
+    waiting.on_rollout_end()
+    assert reports[0]["cost_ratio"] == 2.0 and reports[0]["transmission_ratio"] == 0.5
 
 
 def test_a_summary_names_the_grid_points_that_never_started(tmp_path: Path) -> None:

@@ -127,6 +127,9 @@ def test_a_search_may_use_asha_and_optuna_with_an_objective(tmp_path: Path) -> N
     with pytest.raises(ValueError, match="'grid' must be empty with search_algorithm"):
         rate = {"hyperparameters.learning_rate": search["hyperparameters.learning_rate"]}
         sweep_config_from_dict(sweep(tmp_path, kind="search", **objective, mode="min", search=rate))
+    with pytest.raises(ValueError, match="'cost_ratio' comes from the training run's evalu"):
+        never = {"evaluation_every": 0}
+        sweep_config_from_dict(sweep(tmp_path, **keys, **objective, mode="min", overrides=never))
     with pytest.raises(ValueError, match=r"must be \[low, high\] with low < high"):
         bad = {"hyperparameters.learning_rate": {"uniform": [1.0, 0.5]}}
         sweep_config_from_dict(sweep(tmp_path, kind="search", search=bad))
