@@ -3,6 +3,8 @@ training config of each trial. No Ray needed."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -160,3 +162,27 @@ def test_a_shipped_front_crosses_four_penalties_with_three_seeds(path: Path) -> 
     assert len(config.grid["env_kwargs.transmission_penalty"]) >= 4
     assert len(config.grid["seed"]) >= 3
     assert Path(config.results_dir).parts[-3:-1] == ("runs", "sweeps")
+
+
+def test_the_package_and_the_tools_do_not_import_ray() -> None:
+    code = (
+        "import sys, etsc_envs, agents.train, agents.pareto, agents.results, agents.sweep\n"
+        "assert 'ray' not in sys.modules, 'ray was imported'\n"
+    )
+    subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True)
+
+
+def test_without_ray_the_sweep_command_says_which_extra_to_install() -> None:
+    code = (
+        "import sys\n"
+        "sys.modules['ray'] = None  # as if Ray were not installed\n"
+        "from agents.sweep import main\n"
+        "main(['--config', 'configs/sweeps/tiny.yaml'])\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert run.returncode == 2
+    assert (
+        run.stderr.strip()
+        .splitlines()[-1]
+        .endswith('Ray Tune is not installed: pip install -e ".[train,sweep]"')
+    )
