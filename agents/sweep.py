@@ -73,15 +73,15 @@ def check_reachable(address: str) -> None:
 
 
 def connect(address: str | None) -> None:
-    """Join the Ray cluster at ``address``, or start a Ray instance on this machine."""
+    """Join the Ray cluster at ``address``, or start a Ray instance on this machine (never
+    another one already running here, which Ray's default would join)."""
     import ray
 
     if address is None:
-        ray.init(address="local", include_dashboard=False, log_to_driver=True)
+        ray.init(address="local", include_dashboard=False)
         return
-    check_reachable(address)
     try:
-        ray.init(address=address, log_to_driver=True)
+        ray.init(address=address)
     except ConnectionError as error:
         raise ValueError(
             f"--address: cannot join the Ray cluster at {address!r}: {error}"
@@ -205,6 +205,8 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
             f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
             f"or choose another results_dir"
         )
+    if address is not None:
+        check_reachable(address)
     if resume:
         _check_unchanged(sweep)
     else:
