@@ -182,8 +182,7 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
         _check_training_key("overrides", key)
         _assign(base, key, value)
     base["out_dir"] = "<trial folder>"
-    if base.get("init_from") is not None:
-        base["init_from"] = str(Path(base["init_from"]).resolve())
+    base["init_from"] = _absolute(base.get("init_from"))
     grid = _check_grid(values["grid"])
     search = _check_search(values["search"])
     overlap = sorted(set(grid) & set(search))
@@ -310,12 +309,20 @@ def _check_mapping(key: str, value: Any) -> dict[str, Any]:
     return dict(value)
 
 
+def _absolute(path: Any) -> Any:
+    """A model path as an absolute path (trials run in other folders), other values as they
+    are."""
+    return str(Path(path).resolve()) if isinstance(path, str) else path
+
+
 def _check_grid(value: Any) -> dict[str, list[Any]]:
     grid = _check_mapping("grid", value)
     for key, values in grid.items():
         _check_training_key("grid", key)
         if not isinstance(values, list) or not values:
             raise ValueError(f"sweep key 'grid.{key}' must be a non-empty list, got {values!r}")
+        if key == "init_from":
+            grid[key] = values = [_absolute(entry) for entry in values]
         printed = [format_value(entry) for entry in values]
         if len(set(printed)) != len(printed):
             raise ValueError(f"sweep key 'grid.{key}' repeats a value: {values!r}")

@@ -186,3 +186,15 @@ def test_without_ray_the_sweep_command_says_which_extra_to_install() -> None:
         .splitlines()[-1]
         .endswith('Ray Tune is not installed: pip install -e ".[train,sweep]"')
     )
+
+
+def test_model_paths_are_made_absolute_for_trials_that_run_elsewhere(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "stage1.zip").write_bytes(b"")
+    monkeypatch.chdir(tmp_path)
+    grid = {"init_from": ["stage1.zip"], "seed": [1]}
+    config = sweep_config_from_dict(sweep(tmp_path, grid=grid, results_dir="out"))
+    trial = config.trial_config(config.grid_points()[0], config.trial_folder("t"))
+    assert trial.init_from == str(tmp_path / "stage1.zip")
+    assert config.results_dir == str(tmp_path / "out")
