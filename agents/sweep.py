@@ -162,9 +162,7 @@ def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
         name = Path(result.path).name
         folder = sweep.trial_folder(name)
         error = None if result.error is None else _one_line(result.error)
-        # A trial that never reported has no config in its result: a grid point's values
-        # follow from its name; a search trial's were not drawn yet.
-        values = result.config or grid_values.get(name, {})
+        values = result.config or _started_values(result.path) or grid_values.get(name, {})
         trials.append(
             SweepTrial(
                 name=name,
@@ -183,6 +181,14 @@ def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
             if name not in started
         ]
     return trials
+
+
+def _started_values(tune_trial_dir: str) -> dict[str, Any]:
+    """The values of a trial that never reported (no config in its result), from the
+    ``params.json`` Tune writes when a trial starts; empty if it never started (a grid
+    point's values then follow from its name, a search trial's were not drawn)."""
+    params = Path(tune_trial_dir) / "params.json"
+    return json.loads(params.read_text(encoding="utf-8")) if params.is_file() else {}
 
 
 def _one_line(error: BaseException) -> str:

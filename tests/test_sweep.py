@@ -247,19 +247,17 @@ def test_a_summary_names_the_grid_points_that_never_started(tmp_path: Path) -> N
     config = load_sweep_config(tiny_sweep(tmp_path))
     wrapped = RuntimeError("task failed\nTraceback ...")
     wrapped.cause = ValueError("transmission_penalty must be >= 0\n  in the env")
-    results = [
-        SimpleNamespace(
-            path=str(tmp_path / "tune" / "transmission_penalty=30"),
-            config={"env_kwargs.transmission_penalty": 30.0},
-            error=wrapped,
-        )
-    ]
+    started = tmp_path / "tune" / "transmission_penalty=30"  # crashed before it reported
+    started.mkdir(parents=True)
+    (started / "params.json").write_text('{"env_kwargs.transmission_penalty": 30.0}', "utf-8")
+    results = [SimpleNamespace(path=str(started), config=None, error=wrapped)]
     trials = summarize(config, results)
     assert [(trial.name, trial.status) for trial in trials] == [
         ("transmission_penalty=30", "failed"),
         ("transmission_penalty=100", "incomplete"),
     ]
     assert trials[0].error == "ValueError: transmission_penalty must be >= 0"
+    assert trials[0].values == {"env_kwargs.transmission_penalty": 30.0}
     assert trials[1].values == {"env_kwargs.transmission_penalty": 100.0}
 
 
