@@ -71,6 +71,8 @@ def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
     if not training_finished(folder):
         config = sweep.trial_config(values, folder)
         resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
+        if not resume:  # an interrupted start's evaluations are not this run's
+            (folder / EVALUATIONS_FILE).unlink(missing_ok=True)
         reporter = TuneReportCallback(folder, config.total_timesteps, sweep.metric)
         train(config, resume=resume, callbacks=[reporter])
     tune.report(final_scores(folder))
