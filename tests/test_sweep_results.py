@@ -15,6 +15,7 @@ from stable_baselines3 import PPO
 from agents import pareto, results
 from agents.sweep_results import (
     SweepTrial,
+    final_scores,
     finished_trials,
     read_sweep,
     scores,
@@ -54,6 +55,8 @@ def make_sweep(results_dir: Path) -> None:
     model = PPO("MlpPolicy", env, n_steps=16, batch_size=32, n_epochs=1, device="cpu", seed=0)
     model.learn(total_timesteps=32)
     model.save(finished / "model.zip")
+    summary = {"timesteps": 32, "recent_episodes": [{"return": -1.0}, {"return": -3.0}]}
+    (finished / "train_summary.json").write_text(json.dumps(summary), encoding="utf-8")
     failed.mkdir(parents=True)
     error = "ValueError: transmission_penalty must be >= 0, got -1.0"
     trials = [
@@ -63,7 +66,7 @@ def make_sweep(results_dir: Path) -> None:
             trial_status(finished, None),
             None,
             finished,
-            {"timesteps": 32},
+            final_scores(finished),
         ),
         SweepTrial(
             "transmission_penalty=-1",
@@ -81,6 +84,8 @@ def test_the_summary_reads_back_and_only_finished_trials_count(tmp_path: Path) -
     make_sweep(tmp_path / "sweep")
     summary = json.loads((tmp_path / "sweep" / "sweep_summary.json").read_text("utf-8"))
     assert summary["counts"] == {"finished": 1, "failed": 1, "incomplete": 0}
+    assert summary["trials"][0]["scores"] == {"timesteps": 32, "training_reward": -2.0}
+    assert trial_status(tmp_path / "sweep" / "trials", None) == "incomplete"
     trials = read_sweep(tmp_path / "sweep")
     assert [trial.status for trial in trials] == ["finished", "failed"]
     assert trials[1].error.startswith("ValueError: transmission_penalty")
