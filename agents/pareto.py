@@ -1,8 +1,9 @@
 """Accuracy against transmissions: the paper's trigger, periodic sampling and learned triggers,
 under the test protocol.
 
-    python -m agents.pareto ENV_ID [--model PATH ...] [--scenarios test|validation]
-                                   [--set-size K] [--env-arg k=v ...] [--out DIR]
+    python -m agents.pareto ENV_ID [--model PATH ...] [--sweep RESULTS_DIR ...]
+                                   [--scenarios test|validation] [--set-size K]
+                                   [--env-arg k=v ...] [--out DIR]
                                    [--reuse PARETO_JSON]
 
 Every point of three curves runs on a scenario set of the protocol (default the test set, all
@@ -13,7 +14,8 @@ its scenarios at once in the native vector env) and on the paper scenario:
 * periodic transmission every ``k`` sampling instants (:func:`periodic_sweep`), wide enough
   to reach periods at which the clock fails;
 * each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
-  typically one per transmission penalty λ.
+  typically one per transmission penalty λ, and the model of every finished trial of each
+  ``--sweep`` (the results folder of ``python -m agents.sweep``: a front in one option).
 
 A point records the set's aggregates (mean ``mean_cost`` and transmissions with 95 % bootstrap
 intervals, failures) and the paper scenario's episode. The plot shows each curve's
@@ -39,6 +41,7 @@ from matplotlib import ticker
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.evaluation import episode_summary
+from agents.sweep_results import sweep_models
 from baselines.cli import limit_torch_threads, parse_assignments, require_policies, write_json
 from baselines.evaluate import evaluate
 from baselines.plotting import save
@@ -320,6 +323,13 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--scenarios", choices=("test", "validation"), default="test")
     parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
+    parser.add_argument(
+        "--sweep",
+        action="append",
+        default=[],
+        metavar="RESULTS_DIR",
+        help="add the model of every finished trial of a sweep (agents.sweep; repeatable)",
+    )
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
     parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
     parser.add_argument(
@@ -335,7 +345,8 @@ def main(argv: list[str] | None = None) -> int:
         require_writable_folder(out_dir, "--out")
         env_kwargs = parse_assignments(args.env_arg, "--env-arg")
         reuse = json.loads(args.reuse.read_text(encoding="utf-8")) if args.reuse else None
-        result = pareto(args.env_id, args.model, env_kwargs, args.scenarios, args.set_size, reuse)
+        models = args.model + sweep_models(args.sweep, args.env_id)
+        result = pareto(args.env_id, models, env_kwargs, args.scenarios, args.set_size, reuse)
     except (ValueError, TypeError, OSError, gym.error.Error) as error:
         parser.error(str(error))
     write_json(result, str(out_dir / "pareto.json"))

@@ -1,7 +1,7 @@
 """A learned trigger against the paper's trigger and the clock, under the test protocol: the
 rows of ``docs/results.md``.
 
-    python -m agents.results ENV_ID --model PATH [--model PATH ...]
+    python -m agents.results ENV_ID (--model PATH [--model PATH ...] | --sweep RESULTS_DIR)
                              [--scenarios paper test] [--set-size K] [--env-arg k=v ...]
                              [--out DIR]
 
@@ -26,7 +26,10 @@ rliable's stratified bootstrap interval, and the range of the per-seed IQMs; wit
 page states that there is no claim (a claim stands on at least :data:`MIN_CLAIM_SEEDS` seeds).
 
 Writes ``results.json`` (every episode record included) into ``DIR`` (default
-``results/<env name>``) and prints the tables as Markdown.
+``results/<env name>``) and prints the tables as Markdown. With ``--sweep`` (the results folder
+of ``python -m agents.sweep``) the finished trials that differ only in their seed form one
+method: each such group is compared into ``DIR/<group>/results.json``, its trials' models as
+the method's training seeds.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs
+from agents.sweep_results import finished_trials
 from baselines.cli import (
     episode_setup,
     limit_torch_threads,
@@ -260,6 +264,16 @@ def compare(
     }
 
 
+def seed_groups(trials: list[Any]) -> dict[str, list[str]]:
+    """Sweep trials grouped by their swept values other than ``seed`` (one method each):
+    group name → the models of its trials."""
+    groups: dict[str, list[str]] = {}
+    for trial in trials:
+        kept = [f"{key}={value}" for key, value in sorted(trial.values.items()) if key != "seed"]
+        groups.setdefault(",".join(kept) or "all", []).append(str(trial.model))
+    return groups
+
+
 def _number(value: Any) -> str:
     if value is None:
         return "—"
@@ -360,8 +374,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--model",
         action="append",
-        required=True,
+        default=[],
         help="an SB3 zip of the learned trigger (repeat for several training seeds)",
+    )
+    parser.add_argument(
+        "--sweep",
+        metavar="RESULTS_DIR",
+        help="compare the finished trials of a sweep (agents.sweep), grouped by everything "
+        "but their seed, each group into DIR/<group>/results.json",
     )
     parser.add_argument(
         "--scenarios",
@@ -379,22 +399,37 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     limit_torch_threads()
+    if bool(args.model) == bool(args.sweep):
+        parser.error("give --model (one or more) or --sweep, not both")
     out_dir = Path(args.out or Path("results") / args.env_id.split("/")[-1])
     try:
         require_writable_folder(out_dir, "--out")
-        result = compare(
-            args.env_id,
-            args.model,
-            parse_assignments(args.env_arg, "--env-arg"),
-            tuple(dict.fromkeys(args.scenarios)),
-            args.set_size,
-            progress=True,
+        methods = (
+            {out_dir: args.model}
+            if args.model
+            else {
+                out_dir / group: models
+                for group, models in seed_groups(finished_trials(args.sweep, args.env_id)).items()
+            }
         )
+        env_args = parse_assignments(args.env_arg, "--env-arg")
+        results = {
+            folder: compare(
+                args.env_id,
+                models,
+                env_args,
+                tuple(dict.fromkeys(args.scenarios)),
+                args.set_size,
+                progress=True,
+            )
+            for folder, models in methods.items()
+        }
     except (ValueError, TypeError, gym.error.Error) as error:
         parser.error(str(error))
-    write_json(result, str(out_dir / "results.json"))
-    print(markdown(result))
-    print(f"wrote {out_dir / 'results.json'}")
+    for folder, result in results.items():
+        write_json(result, str(folder / "results.json"))
+        print(markdown(result))
+        print(f"wrote {folder / 'results.json'}")
     return 0
 
 

@@ -32,7 +32,7 @@ import sys
 import time
 import zipfile
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -113,10 +113,14 @@ def _plain(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def train(config: TrainConfig, resume: bool = False) -> Path:
+def train(
+    config: TrainConfig, resume: bool = False, callbacks: Sequence[BaseCallback] = ()
+) -> Path:
     """Train the configured model (from the newest intact checkpoint if ``resume``), write the
-    output files and return the output folder. A bad env kwarg, hyperparameter, ``init_from``
-    or checkpoint raises ``ValueError`` before ``out_dir`` is created."""
+    output files and return the output folder. ``callbacks`` run after the run's own (episode
+    metrics, checkpoints, evaluations), e.g. to report progress to a tuner. A bad env kwarg,
+    hyperparameter, ``init_from`` or checkpoint raises ``ValueError`` before ``out_dir`` is
+    created."""
     torch.set_num_threads(config.torch_threads)
     out_dir = Path(config.out_dir)
     checkpoint = resume_checkpoint(config) if resume else None
@@ -124,14 +128,19 @@ def train(config: TrainConfig, resume: bool = False) -> Path:
         _refuse_foreign_checkpoints(config)
     created = not out_dir.exists()
     try:
-        return _train(config, out_dir, checkpoint)
+        return _train(config, out_dir, checkpoint, callbacks)
     except BaseException:
         if created:
             _remove_empty_folders(out_dir)
         raise
 
 
-def _train(config: TrainConfig, out_dir: Path, checkpoint: Path | None) -> Path:
+def _train(
+    config: TrainConfig,
+    out_dir: Path,
+    checkpoint: Path | None,
+    callbacks: Sequence[BaseCallback],
+) -> Path:
     env = _checked(
         "env_kwargs", make_training_env, config, checkpoint, exceptions=(TypeError, ValueError)
     )
@@ -155,7 +164,7 @@ def _train(config: TrainConfig, out_dir: Path, checkpoint: Path | None) -> Path:
     try:
         model.learn(
             total_timesteps=max(config.total_timesteps - model.num_timesteps, 0),
-            callback=CallbackList([metrics_callback, *periodic, *progress]),
+            callback=CallbackList([metrics_callback, *periodic, *callbacks, *progress]),
             reset_num_timesteps=checkpoint is None,
         )
     finally:

@@ -1,0 +1,313 @@
+"""Training sweeps on Ray Tune: a grid (or a search) over training-config keys, every trial one
+``agents.train`` run.
+
+``python -m agents.sweep --config configs/sweeps/NAME.yaml [--address ADDR] [--resume]``
+
+Without ``--address`` (and without ``RAY_ADDRESS``) the command starts a Ray instance on this
+machine and stops it at the end; with one it joins that cluster (``ray start --head`` on one
+machine, ``ray start --address HEAD:6379`` on the others, or ``ray up``). Each trial reserves
+``cpus_per_trial`` cores, so Ray runs as many trials at once as the cores allow. The config's
+keys are in :mod:`agents.sweep_config`; the results folder's layout in
+:mod:`agents.sweep_results`.
+
+``--resume`` continues an interrupted sweep from Tune's saved state (``Tuner.restore``):
+finished and failed trials are not run again; interrupted ones start again (from their newest
+checkpoint when the training config saves checkpoints).
+
+A trial that raises is recorded as failed with its error and does not stop the others. The
+command writes ``sweep_summary.json`` and prints one line per trial; it exits with 1 when a
+trial failed, or when a front is incomplete, else 0.
+
+Needs the ``sweep`` extra (``pip install -e ".[train,sweep]"``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import os
+import socket
+import sys
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlsplit
+
+import yaml
+
+from agents.sweep_config import SweepConfig, load_sweep_config
+from agents.sweep_results import (
+    SETTINGS_FILE,
+    SweepTrial,
+    final_scores,
+    trial_status,
+    write_summary,
+)
+from etsc_envs.core.files import atomic_write_text, require_writable_folder
+
+CONNECT_TIMEOUT_S = 5.0
+"""How long the command waits for a Ray address to accept a connection."""
+
+
+def check_reachable(address: str) -> None:
+    """``ValueError`` unless ``address`` (``host:port`` or ``ray://host:port``) accepts a TCP
+    connection within :data:`CONNECT_TIMEOUT_S` (Ray itself would retry for minutes).
+    ``auto`` and ``local`` are Ray's own words and pass through."""
+    if address in ("auto", "local"):
+        return
+    parts = urlsplit(address if "://" in address else f"//{address}")
+    try:
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        host, port = None, None
+    if not host or port is None:
+        raise ValueError(f"--address must be HOST:PORT or ray://HOST:PORT, got {address!r}")
+    try:
+        with socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S):
+            pass
+    except OSError as error:
+        raise ValueError(
+            f"--address: no Ray cluster answers at {address!r} ({error.strerror or error}); "
+            f"start one with 'ray start --head' or leave --address out to run on this machine"
+        ) from None
+
+
+def connect(address: str | None) -> None:
+    """Join the Ray cluster at ``address``, or start a Ray instance on this machine (never
+    another one already running here, which Ray's default would join)."""
+    import ray
+
+    if address is None:
+        ray.init(address="local", include_dashboard=False)
+        return
+    try:
+        ray.init(address=address)
+    except ConnectionError as error:
+        raise ValueError(
+            f"--address: cannot join the Ray cluster at {address!r}: {error}"
+        ) from None
+
+
+def build_tuner(sweep: SweepConfig, resume: bool) -> Any:
+    """A ``Tuner`` for the sweep: new, or restored from its saved state when ``resume``."""
+    from ray import tune
+
+    from agents.sweep_trial import run_trial, trial_dirname
+
+    trainable = tune.with_resources(
+        tune.with_parameters(run_trial, sweep=sweep), {"cpu": sweep.cpus_per_trial}
+    )
+    if resume:
+        return tune.Tuner.restore(str(sweep.tune_dir), trainable=trainable)
+    return tune.Tuner(
+        trainable,
+        param_space=_param_space(sweep),
+        tune_config=tune.TuneConfig(
+            num_samples=sweep.num_samples,
+            max_concurrent_trials=sweep.max_concurrent_trials,
+            scheduler=_scheduler(sweep),
+            search_alg=_search_algorithm(sweep),
+            metric=sweep.metric,
+            mode=sweep.mode,
+            trial_dirname_creator=functools.partial(trial_dirname, sweep),
+        ),
+        run_config=tune.RunConfig(
+            name=sweep.tune_dir.name,
+            storage_path=str(sweep.tune_dir.parent),
+            failure_config=tune.FailureConfig(max_failures=0, fail_fast=False),
+        ),
+    )
+
+
+def _param_space(sweep: SweepConfig) -> dict[str, Any]:
+    from ray import tune
+
+    space: dict[str, Any] = {key: tune.grid_search(values) for key, values in sweep.grid.items()}
+    for key, spec in sweep.search.items():
+        ((distribution, arguments),) = spec.items()
+        sampler = getattr(tune, distribution)
+        space[key] = sampler(arguments) if distribution == "choice" else sampler(*arguments)
+    return space
+
+
+def _scheduler(sweep: SweepConfig) -> Any:
+    if sweep.scheduler is None:
+        return None
+    from ray.tune.schedulers import ASHAScheduler
+
+    grace = sweep.grace_timesteps or max(sweep.total_timesteps // 10, 1)
+    return ASHAScheduler(
+        time_attr="timesteps",
+        max_t=sweep.total_timesteps,
+        grace_period=min(grace, sweep.total_timesteps),
+    )
+
+
+def _search_algorithm(sweep: SweepConfig) -> Any:
+    if sweep.search_algorithm is None:
+        return None
+    from ray.tune.search.optuna import OptunaSearch
+
+    return OptunaSearch()
+
+
+def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
+    """Every trial of Tune's ``ResultGrid`` as the summary records it, in Tune's order (the
+    grid's), and, for a grid, the points that Tune had not started when it was interrupted."""
+    grid_values = {}
+    if not sweep.search:
+        grid_values = {sweep.trial_name(point): point for point in sweep.grid_points()}
+    trials = []
+    for result in results:
+        name = Path(result.path).name
+        folder = sweep.trial_folder(name)
+        error = None if result.error is None else _one_line(result.error)
+        values = result.config or _started_values(result.path) or grid_values.get(name, {})
+        trials.append(
+            SweepTrial(
+                name=name,
+                values={key: values[key] for key in sweep.swept_keys if key in values},
+                status=trial_status(folder, error),
+                error=error,
+                folder=folder,
+                scores=final_scores(folder) if error is None else None,
+            )
+        )
+    if grid_values:  # grid points that Tune had not created when it was interrupted
+        started = {trial.name for trial in trials}
+        trials += [
+            SweepTrial(name, values, "incomplete", None, sweep.trial_folder(name), None)
+            for name, values in grid_values.items()
+            if name not in started
+        ]
+    return trials
+
+
+def _started_values(tune_trial_dir: str) -> dict[str, Any]:
+    """The values of a trial that never reported (no config in its result), from the
+    ``params.json`` Tune writes when a trial starts; empty if it never started (a grid
+    point's values then follow from its name, a search trial's were not drawn)."""
+    params = Path(tune_trial_dir) / "params.json"
+    return json.loads(params.read_text(encoding="utf-8")) if params.is_file() else {}
+
+
+def _one_line(error: BaseException) -> str:
+    """A trial's error as ``Type: first line of its message``, the underlying exception's when
+    Ray wraps it."""
+    cause = getattr(error, "cause", None) or error
+    lines = str(cause).strip().splitlines()
+    return f"{type(cause).__name__}: {lines[0]}" if lines else type(cause).__name__
+
+
+def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[SweepTrial]:
+    """Run (or resume) the sweep on Ray, write its summary and return its trials."""
+    import ray
+    from ray import tune
+
+    if resume and not tune.Tuner.can_restore(str(sweep.tune_dir)):
+        raise ValueError(f"--resume: no saved sweep in {str(sweep.tune_dir)!r} to continue")
+    if not resume and (sweep.tune_dir.exists() or sweep.trials_dir.exists()):
+        raise ValueError(
+            f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
+            f"or choose another results_dir"
+        )
+    if address is not None:
+        check_reachable(address)
+    if resume:
+        _check_unchanged(sweep)
+    else:
+        atomic_write_text(Path(sweep.results_dir) / SETTINGS_FILE, _settings_json(sweep))
+    connect(address)
+    try:
+        results = build_tuner(sweep, resume).fit()
+    finally:
+        ray.shutdown()
+    trials = summarize(sweep, results)
+    write_summary(sweep.results_dir, _description(sweep), trials)
+    return trials
+
+
+def _settings_json(sweep: SweepConfig) -> str:
+    return json.dumps(sweep.settings(), indent=2, sort_keys=True) + "\n"
+
+
+def _check_unchanged(sweep: SweepConfig) -> None:
+    """``ValueError`` if the sweep's settings differ from those it started with (Tune resumes
+    the trials it planned then; changed settings would mislabel them)."""
+    path = Path(sweep.results_dir) / SETTINGS_FILE
+    if not path.is_file():
+        return
+    started = json.loads(path.read_text(encoding="utf-8"))
+    now = json.loads(_settings_json(sweep))
+    changed = sorted(key for key in {*started, *now} if started.get(key) != now.get(key))
+    if changed:
+        raise ValueError(
+            f"--resume: the sweep's {changed} changed since it started (see {str(path)!r}); "
+            f"resume it with the settings it started with, or start another results_dir"
+        )
+
+
+def _description(sweep: SweepConfig) -> dict[str, Any]:
+    return {
+        "sweep": sweep.path,
+        "env_id": sweep.base["env_id"],
+        "kind": sweep.kind,
+        "swept_keys": sweep.swept_keys,
+    }
+
+
+def _report(sweep: SweepConfig, trials: list[SweepTrial]) -> int:
+    """Print one line per trial and the exit code of the sweep."""
+    for trial in trials:
+        detail = trial.error if trial.status == "failed" else ""
+        if trial.status == "finished" and trial.scores:
+            detail = " ".join(f"{key} {value:.4g}" for key, value in trial.scores.items())
+        print(f"{trial.status:10s} {trial.name}  {detail}".rstrip())
+    incomplete = [trial for trial in trials if trial.status == "incomplete"]
+    if incomplete:
+        print(f"{len(incomplete)} trial(s) incomplete; continue with --resume", file=sys.stderr)
+    print(f"wrote {Path(sweep.results_dir) / 'sweep_summary.json'}")
+    failed = any(trial.status == "failed" for trial in trials)
+    return 1 if failed or (sweep.kind == "front" and incomplete) else 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command line of :func:`main`."""
+    parser = argparse.ArgumentParser(
+        prog="python -m agents.sweep",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--config", required=True, type=Path, help="YAML sweep config")
+    parser.add_argument(
+        "--address",
+        help="Ray cluster to run on (HOST:PORT, ray://HOST:PORT or auto; default RAY_ADDRESS, "
+        "else a Ray instance started on this machine)",
+    )
+    parser.add_argument(
+        "--resume", action="store_true", help="continue the interrupted sweep of the config"
+    )
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line: validate the config, run the sweep, report its trials."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        import ray  # noqa: F401
+        from ray import tune  # noqa: F401
+    except ImportError:
+        parser.error('Ray Tune is not installed: pip install -e ".[train,sweep]"')
+    address = args.address or os.environ.get("RAY_ADDRESS") or None
+    try:
+        sweep = load_sweep_config(args.config)
+        require_writable_folder(sweep.results_dir, "results_dir")
+        trials = run_sweep(sweep, address, args.resume)
+    except (OSError, ValueError, yaml.YAMLError) as error:
+        parser.error(str(error))
+    return _report(sweep, trials)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

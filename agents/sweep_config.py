@@ -1,0 +1,460 @@
+"""Sweep configuration: the YAML keys of ``configs/sweeps/*.yaml``, their validation, and how a
+trial's values become one training config. No Ray here: this module only reads and checks.
+
+A sweep config is a YAML mapping with these keys (the optional ones show their default):
+
+* ``base`` — the training config (``configs/train/*.yaml``, keys in :mod:`agents.config`)
+  that every trial starts from;
+* ``results_dir`` — the sweep's results folder: one subfolder per trial under ``trials/``
+  (model, normalisation statistics, resolved config, evaluations), the sweep summary and
+  Ray Tune's experiment state under ``tune/``;
+* ``kind`` — ``front`` (the trials form a reported front, e.g. transmission penalty × seed:
+  every trial runs to its end, so neither a scheduler nor a search algorithm is allowed) or
+  ``search`` (a hyperparameter search, which may use them);
+* ``overrides: {}`` — training-config keys set in every trial;
+* ``grid: {}`` — training-config key → list of values; every combination is one trial;
+* ``search: {}`` — training-config key → a distribution sampled per trial, one of
+  ``{uniform: [low, high]}``, ``{loguniform: [low, high]}``, ``{randint: [low, high]}``
+  (``high`` excluded) or ``{choice: [values]}``; search sweeps only;
+* ``num_samples: 1`` — trials drawn from ``search`` (each over the whole grid); search only;
+* ``scheduler: null`` — ``asha`` stops hopeless trials early (Tune's ``ASHAScheduler`` on
+  the training timesteps); search only;
+* ``grace_timesteps: null`` — ASHA never stops a trial before this many timesteps (default a
+  tenth of ``total_timesteps``);
+* ``search_algorithm: null`` — ``optuna`` draws the ``search`` values with Tune's
+  ``OptunaSearch`` (then ``grid`` must be empty); search only;
+* ``metric: null``, ``mode: null`` — the reported metric (:data:`agents.sweep_results.METRICS`)
+  that the scheduler or search algorithm optimises, and ``min`` or ``max``; required with
+  either of them. A trial reports to Tune only once it has that metric (the evaluation
+  metrics need ``evaluation_every``);
+* ``cpus_per_trial: 1`` — CPU cores each trial reserves on the Ray cluster, so a 2-core
+  machine runs two trials at a time and a cluster as many as it has cores;
+* ``max_concurrent_trials: null`` — at most this many trials at once (null: as many as the
+  cores allow).
+
+Keys of ``overrides``, ``grid`` and ``search`` are training-config keys, dotted to reach into
+a mapping: ``seed``, ``total_timesteps``, ``env_kwargs.transmission_penalty``,
+``hyperparameters.learning_rate``. Paths (``base``, ``results_dir``, the training config's
+``init_from``) are relative to the current folder, as in ``agents.train``.
+
+Every problem raises a one-line ``ValueError`` naming the key and what it allows.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import itertools
+import json
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from agents.config import OPTIONAL_DEFAULTS, REQUIRED_KEYS, TrainConfig, config_from_dict
+from agents.sweep_results import EVALUATION_METRICS, METRICS, TRIALS_DIR
+
+KINDS = ("front", "search")
+SCHEDULERS = ("asha",)
+SEARCH_ALGORITHMS = ("optuna",)
+MODES = ("min", "max")
+DISTRIBUTIONS = ("uniform", "loguniform", "randint", "choice")
+
+REQUIRED_SWEEP_KEYS = ("base", "results_dir", "kind")
+OPTIONAL_SWEEP_DEFAULTS: dict[str, Any] = {
+    "overrides": {},
+    "grid": {},
+    "search": {},
+    "num_samples": 1,
+    "scheduler": None,
+    "grace_timesteps": None,
+    "search_algorithm": None,
+    "metric": None,
+    "mode": None,
+    "cpus_per_trial": 1,
+    "max_concurrent_trials": None,
+}
+NESTED_TRAINING_KEYS = ("env_kwargs", "hyperparameters", "evaluation_env_kwargs")
+"""Training-config keys whose value is a mapping that a dotted key may reach into."""
+
+TUNE_DIR = "tune"
+"""Subfolder of ``results_dir`` that holds Ray Tune's experiment state."""
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepConfig:
+    """A validated sweep config; see the module docstring for the meaning of each field.
+
+    ``base`` is the base training config as a mapping (``overrides`` applied, paths made
+    absolute), ready for :meth:`trial_config`.
+    """
+
+    path: str
+    base: dict[str, Any]
+    results_dir: str
+    kind: str
+    grid: dict[str, list[Any]]
+    search: dict[str, dict[str, list[Any]]]
+    num_samples: int
+    scheduler: str | None
+    grace_timesteps: int | None
+    search_algorithm: str | None
+    metric: str | None
+    mode: str | None
+    cpus_per_trial: float
+    max_concurrent_trials: int | None
+
+    def settings(self) -> dict[str, Any]:
+        """Every setting of the sweep (not the path of its YAML), as JSON-ready data."""
+        settings = dataclasses.asdict(self)
+        del settings["path"]
+        return settings
+
+    @property
+    def swept_keys(self) -> list[str]:
+        """The keys that vary between trials, grid first, in the config's order."""
+        return [*self.grid, *self.search]
+
+    @property
+    def total_timesteps(self) -> int:
+        """The base training length (every trial's, unless swept)."""
+        return int(self.base["total_timesteps"])
+
+    @property
+    def tune_dir(self) -> Path:
+        """Ray Tune's experiment folder."""
+        return Path(self.results_dir) / TUNE_DIR
+
+    def grid_points(self) -> list[dict[str, Any]]:
+        """Every combination of the grid's values, in the config's order."""
+        keys = list(self.grid)
+        combinations = itertools.product(*self.grid.values())
+        return [dict(zip(keys, values, strict=True)) for values in combinations]
+
+    def trial_name(self, values: Mapping[str, Any], trial_id: str | None = None) -> str:
+        """A trial's folder name: its swept values as ``key=value`` joined by commas (the last
+        part of a dotted key, unless two swept keys share it), e.g.
+        ``transmission_penalty=0.05,seed=1``; a search trial adds its Tune ``trial_id``
+        (sampled values need not differ in their printed digits)."""
+        labels = _labels(self.swept_keys)
+        parts = [f"{labels[key]}={format_value(values[key])}" for key in self.swept_keys]
+        if self.search and trial_id is not None:
+            parts.append(f"trial={trial_id}")
+        return ",".join(parts) or "trial"
+
+    @property
+    def trials_dir(self) -> Path:
+        """The folder of the trials' folders."""
+        return Path(self.results_dir) / TRIALS_DIR
+
+    def trial_folder(self, name: str) -> Path:
+        """Where the trial called ``name`` writes its training outputs."""
+        return self.trials_dir / name
+
+    def trial_config(self, values: Mapping[str, Any], out_dir: str | Path) -> TrainConfig:
+        """The validated training config of the trial with the swept ``values``."""
+        raw = copy.deepcopy(self.base)
+        for key, value in values.items():
+            _assign(raw, key, value)
+        raw["out_dir"] = str(out_dir)
+        return config_from_dict(raw)
+
+
+def load_sweep_config(path: str | Path) -> SweepConfig:
+    """Read a sweep YAML, validate it and every grid point's training config."""
+    with open(path, encoding="utf-8") as stream:
+        raw = yaml.safe_load(stream)
+    if not isinstance(raw, dict):
+        raise ValueError(f"{path}: a sweep config must be a YAML mapping of keys to values")
+    return sweep_config_from_dict(raw, str(path))
+
+
+def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> SweepConfig:
+    """Validate a sweep config mapping (see the module docstring) and fill in the defaults."""
+    _check_key_set(raw)
+    values = {**OPTIONAL_SWEEP_DEFAULTS, **raw}
+    kind = _check_choice("kind", values["kind"], KINDS)
+    base = _load_base(values["base"])
+    overrides = _check_mapping("overrides", values["overrides"])
+    for key, value in overrides.items():
+        _check_training_key("overrides", key)
+        _assign(base, key, value)
+    base["out_dir"] = "<trial folder>"
+    base["init_from"] = _absolute(base.get("init_from"))
+    grid = _check_grid(values["grid"])
+    search = _check_search(values["search"])
+    overlap = sorted(set(grid) & set(search))
+    if overlap:
+        raise ValueError(f"sweep keys {overlap} are in both 'grid' and 'search'; keep each in one")
+    scheduler = _check_optional_choice("scheduler", values["scheduler"], SCHEDULERS)
+    search_algorithm = _check_optional_choice(
+        "search_algorithm", values["search_algorithm"], SEARCH_ALGORITHMS
+    )
+    num_samples = _check_positive_int("num_samples", values["num_samples"])
+    if kind == "front":
+        _check_front(search, num_samples, scheduler, search_algorithm, values["grace_timesteps"])
+    if search_algorithm is not None and grid:
+        raise ValueError(
+            "sweep key 'grid' must be empty with search_algorithm 'optuna': Optuna samples "
+            "every swept key; give them as 'search' distributions (choice for a list)"
+        )
+    if not grid and not search:
+        raise ValueError("sweep keys 'grid' and 'search' are both empty: a sweep needs trials")
+    metric, mode = _check_objective(values["metric"], values["mode"], scheduler, search_algorithm)
+    config = SweepConfig(
+        path=path,
+        base=base,
+        results_dir=str(_check_path("results_dir", values["results_dir"]).resolve()),
+        kind=kind,
+        grid=grid,
+        search=search,
+        num_samples=num_samples,
+        scheduler=scheduler,
+        grace_timesteps=_check_grace(values["grace_timesteps"], scheduler),
+        search_algorithm=search_algorithm,
+        metric=metric,
+        mode=mode,
+        cpus_per_trial=_check_positive_number("cpus_per_trial", values["cpus_per_trial"]),
+        max_concurrent_trials=_check_optional_positive_int(
+            "max_concurrent_trials", values["max_concurrent_trials"]
+        ),
+    )
+    _check_trial_configs(config)
+    return config
+
+
+def format_value(value: Any) -> str:
+    """A swept value as it appears in a trial's folder name (no ``/``, no spaces)."""
+    if isinstance(value, bool) or value is None:
+        text = json.dumps(value)
+    elif isinstance(value, float):
+        text = format(value, ".6g")
+    elif isinstance(value, int | str):
+        text = str(value)
+    else:
+        text = json.dumps(value, separators=(",", ":"))
+    return text.replace("/", "_").replace(" ", "")
+
+
+def _labels(keys: list[str]) -> dict[str, str]:
+    """Each key's last dotted part, or the whole key where two keys share that part."""
+    last = [key.rpartition(".")[2] for key in keys]
+    pairs = zip(keys, last, strict=True)
+    return {key: key if last.count(part) > 1 else part for key, part in pairs}
+
+
+def _assign(raw: dict[str, Any], key: str, value: Any) -> None:
+    """Set the dotted training-config ``key`` of ``raw`` to ``value``."""
+    top, _, inner = key.partition(".")
+    if not inner:
+        raw[top] = copy.deepcopy(value)
+        return
+    nested = raw.get(top)
+    raw[top] = {**(nested if isinstance(nested, dict) else {}), inner: copy.deepcopy(value)}
+
+
+def _check_key_set(raw: Mapping[str, Any]) -> None:
+    allowed = (*REQUIRED_SWEEP_KEYS, *OPTIONAL_SWEEP_DEFAULTS)
+    unknown = sorted(str(key) for key in raw if key not in allowed)
+    if unknown:
+        raise ValueError(f"unknown sweep key(s) {unknown}; allowed keys: {list(allowed)}")
+    missing = [key for key in REQUIRED_SWEEP_KEYS if key not in raw]
+    if missing:
+        raise ValueError(
+            f"missing sweep key(s) {missing}; required keys: {list(REQUIRED_SWEEP_KEYS)}"
+        )
+
+
+def _check_training_key(section: str, key: Any) -> str:
+    """A dotted training-config key: a top-level key, or ``<mapping key>.<name>``."""
+    allowed = [key for key in (*REQUIRED_KEYS, *OPTIONAL_DEFAULTS) if key != "out_dir"]
+    if not isinstance(key, str):
+        raise ValueError(f"sweep key {section!r}: {key!r} is not a training-config key")
+    top, dot, inner = key.partition(".")
+    if top not in allowed or (dot and (top not in NESTED_TRAINING_KEYS or not inner)):
+        raise ValueError(
+            f"sweep key {section!r}: unknown training-config key {key!r}; allowed: {allowed}, "
+            f"or {list(NESTED_TRAINING_KEYS)} followed by '.name'"
+        )
+    return key
+
+
+def _load_base(value: Any) -> dict[str, Any]:
+    path = _check_path("base", value)
+    try:
+        with open(path, encoding="utf-8") as stream:
+            raw = yaml.safe_load(stream)
+    except OSError as error:
+        raise ValueError(
+            f"sweep key 'base': cannot read {str(path)!r} ({error.strerror})"
+        ) from None
+    if not isinstance(raw, dict):
+        raise ValueError(f"sweep key 'base': {str(path)!r} is not a YAML mapping of keys to values")
+    return raw
+
+
+def _check_path(key: str, value: Any) -> Path:
+    if not isinstance(value, str) or not value:
+        raise ValueError(f"sweep key {key!r} must be a path, got {value!r}")
+    return Path(value)
+
+
+def _check_mapping(key: str, value: Any) -> dict[str, Any]:
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise ValueError(f"sweep key {key!r} must be a mapping of keys to values, got {value!r}")
+    return dict(value)
+
+
+def _absolute(path: Any) -> Any:
+    """A model path as an absolute path (trials run in other folders), other values as they
+    are."""
+    return str(Path(path).resolve()) if isinstance(path, str) else path
+
+
+def _check_grid(value: Any) -> dict[str, list[Any]]:
+    grid = _check_mapping("grid", value)
+    for key, values in grid.items():
+        _check_training_key("grid", key)
+        if not isinstance(values, list) or not values:
+            raise ValueError(f"sweep key 'grid.{key}' must be a non-empty list, got {values!r}")
+        if key == "init_from":
+            grid[key] = values = [_absolute(entry) for entry in values]
+        printed = [format_value(entry) for entry in values]
+        if len(set(printed)) != len(printed):
+            raise ValueError(f"sweep key 'grid.{key}' repeats a value: {values!r}")
+    return grid
+
+
+def _check_search(value: Any) -> dict[str, dict[str, list[Any]]]:
+    search = _check_mapping("search", value)
+    for key, spec in search.items():
+        _check_training_key("search", key)
+        if not isinstance(spec, dict) or len(spec) != 1 or next(iter(spec)) not in DISTRIBUTIONS:
+            raise ValueError(
+                f"sweep key 'search.{key}' must be one of {{uniform: [low, high]}}, "
+                f"{{loguniform: [low, high]}}, {{randint: [low, high]}}, {{choice: [values]}}; "
+                f"got {spec!r}"
+            )
+        ((distribution, arguments),) = spec.items()
+        _check_distribution(f"search.{key}.{distribution}", distribution, arguments)
+    return search
+
+
+def _check_distribution(key: str, distribution: str, arguments: Any) -> None:
+    if distribution == "choice":
+        if not isinstance(arguments, list) or not arguments:
+            raise ValueError(f"sweep key {key!r} must be a non-empty list, got {arguments!r}")
+        return
+    numbers = isinstance(arguments, list) and len(arguments) == 2
+    numbers = numbers and all(
+        isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)
+        for x in arguments
+    )
+    if distribution == "randint":
+        numbers = numbers and all(isinstance(x, int) for x in arguments)
+    if not numbers or not arguments[0] < arguments[1]:
+        raise ValueError(
+            f"sweep key {key!r} must be [low, high] with low < high, got {arguments!r}"
+        )
+    if distribution == "loguniform" and arguments[0] <= 0:
+        raise ValueError(f"sweep key {key!r} needs low > 0, got {arguments!r}")
+
+
+def _check_front(
+    search: dict[str, Any],
+    num_samples: int,
+    scheduler: str | None,
+    search_algorithm: str | None,
+    grace_timesteps: Any,
+) -> None:
+    """A front's trials all run to their end and form a fixed grid."""
+    offending = [
+        key
+        for key, present in (
+            ("scheduler", scheduler is not None),
+            ("search_algorithm", search_algorithm is not None),
+            ("grace_timesteps", grace_timesteps is not None),
+            ("search", bool(search)),
+            ("num_samples", num_samples != 1),
+        )
+        if present
+    ]
+    if offending:
+        raise ValueError(
+            f"sweep keys {offending} are for kind 'search': the trials of a front (kind "
+            f"'front') are never stopped early or sampled, as that would bias the comparison"
+        )
+
+
+def _check_objective(
+    metric: Any, mode: Any, scheduler: str | None, search_algorithm: str | None
+) -> tuple[str | None, str | None]:
+    if scheduler is None and search_algorithm is None:
+        if metric is not None or mode is not None:
+            raise ValueError("sweep keys 'metric' and 'mode' need a scheduler or search_algorithm")
+        return None, None
+    metric = _check_choice("metric", metric, METRICS)
+    return metric, _check_choice("mode", mode, MODES)
+
+
+def _check_grace(value: Any, scheduler: str | None) -> int | None:
+    if value is None:
+        return None
+    if scheduler is None:
+        raise ValueError("sweep key 'grace_timesteps' needs scheduler 'asha'")
+    return _check_positive_int("grace_timesteps", value)
+
+
+def _check_choice(key: str, value: Any, allowed: tuple[str, ...]) -> str:
+    if value not in allowed:
+        raise ValueError(f"sweep key {key!r} must be one of {list(allowed)}, got {value!r}")
+    return value
+
+
+def _check_optional_choice(key: str, value: Any, allowed: tuple[str, ...]) -> str | None:
+    return None if value is None else _check_choice(key, value, allowed)
+
+
+def _check_positive_int(key: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ValueError(f"sweep key {key!r} must be a positive integer, got {value!r}")
+    return value
+
+
+def _check_optional_positive_int(key: str, value: Any) -> int | None:
+    return None if value is None else _check_positive_int(key, value)
+
+
+def _check_positive_number(key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise ValueError(f"sweep key {key!r} must be a positive number, got {value!r}")
+    return float(value)
+
+
+def _check_trial_configs(config: SweepConfig) -> None:
+    """Build the training config of every grid point (a search's keys at their lower bounds
+    or first choice), so that a bad value is refused before any trial starts."""
+    sample = {key: _first_value(spec) for key, spec in config.search.items()}
+    for point in config.grid_points():
+        values = {**point, **sample}
+        try:
+            trial = config.trial_config(values, config.trials_dir)
+        except ValueError as error:
+            where = config.trial_name(values) if values else "the base config"
+            raise ValueError(f"{config.path}: trial {where}: {error}") from None
+        if config.metric in EVALUATION_METRICS and not trial.evaluation_every:
+            raise ValueError(
+                f"sweep key 'metric': {config.metric!r} comes from the training run's "
+                f"evaluations, and evaluation_every is 0; set it in the base config or "
+                f"'overrides'"
+            )
+
+
+def _first_value(spec: dict[str, list[Any]]) -> Any:
+    """A distribution's lower bound, or a choice's first value."""
+    (arguments,) = spec.values()
+    return arguments[0]

@@ -1,0 +1,202 @@
+"""A sweep's results folder: the scores a trial reports, the sweep summary, and reading the
+finished trials back (for ``agents.pareto`` and ``agents.results``). No Ray here.
+
+Layout of a sweep's ``results_dir`` (see :mod:`agents.sweep_config`)::
+
+    sweep_summary.json          every trial: name, swept values, status, error, final scores
+    sweep_settings.json         the validated sweep config it started with (``--resume``
+                                refuses changed settings)
+    trials/<name>/              one ``agents.train`` run: model.zip, model_vecnormalize.pkl,
+                                config.yaml, evaluations.json, train_summary.json, ...
+    tune/                       Ray Tune's experiment state (what ``--resume`` restores)
+
+A trial's status is ``finished`` (its model was saved), ``failed`` (it raised; ``error`` says
+what) or ``incomplete`` (neither: interrupted, or stopped early by a search's scheduler).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from etsc_envs.core.files import atomic_write_text
+
+SUMMARY_FILE = "sweep_summary.json"
+SETTINGS_FILE = "sweep_settings.json"
+TRIALS_DIR = "trials"
+MODEL_FILE = "model.zip"
+EVALUATIONS_FILE = "evaluations.json"
+TRAIN_SUMMARY_FILE = "train_summary.json"
+CONFIG_FILE = "config.yaml"
+STATUSES = ("finished", "failed", "incomplete")
+
+METRICS = (
+    "timesteps",
+    "training_reward",
+    "learned_mean_cost",
+    "learned_transmissions",
+    "paper_mean_cost",
+    "paper_transmissions",
+    "cost_ratio",
+    "transmission_ratio",
+)
+"""What a trial reports to Tune (the last four once the training callback has evaluated):
+training steps, the mean return of the last training episodes, the last evaluation's
+``mean_cost`` and transmissions of the learned policy and of the paper trigger, and their
+ratios learned / paper (absent where the paper's value is 0)."""
+
+EVALUATION_METRICS = METRICS[2:]
+"""The metrics that come from the training run's evaluations against the paper trigger."""
+
+
+def scores(
+    timesteps: int, training_reward: float | None, evaluation: dict[str, Any] | None
+) -> dict[str, Any]:
+    """The reported metrics (:data:`METRICS`) from the training steps, the mean training
+    return (``None`` before an episode ended) and the last entry of ``evaluations.json``
+    (``None`` before the first)."""
+    result: dict[str, Any] = {"timesteps": int(timesteps)}
+    if training_reward is not None:
+        result["training_reward"] = float(training_reward)
+    if evaluation is None:
+        return result
+    learned, paper = evaluation["learned"], evaluation["paper"]
+    for name, summary in (("learned", learned), ("paper", paper)):
+        result[f"{name}_mean_cost"] = summary["mean_cost"]
+        result[f"{name}_transmissions"] = summary["transmissions"]
+    for ratio, key in (("cost_ratio", "mean_cost"), ("transmission_ratio", "transmissions")):
+        if paper[key]:
+            result[ratio] = learned[key] / paper[key]
+    return result
+
+
+def last_evaluation(folder: str | Path) -> dict[str, Any] | None:
+    """The last entry of a training run's ``evaluations.json``, or ``None`` if it has none."""
+    path = Path(folder) / EVALUATIONS_FILE
+    if not path.is_file():
+        return None
+    evaluations = json.loads(path.read_text(encoding="utf-8"))
+    return evaluations[-1] if evaluations else None
+
+
+def final_scores(folder: str | Path) -> dict[str, Any] | None:
+    """The metrics of a finished training run, from its ``train_summary.json`` (steps and the
+    mean return of its last episodes) and ``evaluations.json``; ``None`` if it did not finish."""
+    summary_path = Path(folder) / TRAIN_SUMMARY_FILE
+    if not summary_path.is_file():
+        return None
+    summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    returns = [episode["return"] for episode in summary.get("recent_episodes", [])]
+    reward = float(np.mean(returns)) if returns else None
+    return scores(summary["timesteps"], reward, last_evaluation(folder))
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepTrial:
+    """One trial of a sweep as the summary records it."""
+
+    name: str
+    values: dict[str, Any]
+    status: str
+    error: str | None
+    folder: Path
+    scores: dict[str, Any] | None
+
+    @property
+    def model(self) -> Path:
+        """The trial's saved model (its normalisation statistics lie beside it)."""
+        return self.folder / MODEL_FILE
+
+    def record(self, results_dir: Path) -> dict[str, Any]:
+        """The trial's entry in ``sweep_summary.json`` (folder relative to ``results_dir``)."""
+        return {
+            "name": self.name,
+            "values": self.values,
+            "status": self.status,
+            "error": self.error,
+            "folder": self.folder.relative_to(results_dir).as_posix(),
+            "scores": self.scores,
+        }
+
+
+def training_finished(folder: str | Path) -> bool:
+    """Whether the training run in ``folder`` finished: ``agents.train`` writes its summary
+    last, after the model."""
+    folder = Path(folder)
+    return (folder / MODEL_FILE).is_file() and (folder / TRAIN_SUMMARY_FILE).is_file()
+
+
+def trial_status(folder: Path, error: str | None) -> str:
+    """``failed`` if the trial raised, else ``finished`` if its training finished, else
+    ``incomplete``."""
+    if error is not None:
+        return "failed"
+    return "finished" if training_finished(folder) else "incomplete"
+
+
+def write_summary(results_dir: str | Path, sweep: dict[str, Any], trials: list[SweepTrial]) -> Path:
+    """Write ``sweep_summary.json`` (whole or not at all): the sweep's description and every
+    trial's record, with the count of trials in each status."""
+    results_dir = Path(results_dir)
+    counts = {status: sum(trial.status == status for trial in trials) for status in STATUSES}
+    summary = {
+        **sweep,
+        "counts": counts,
+        "trials": [trial.record(results_dir) for trial in trials],
+    }
+    return atomic_write_text(results_dir / SUMMARY_FILE, json.dumps(summary, indent=2) + "\n")
+
+
+def read_summary(results_dir: str | Path) -> dict[str, Any]:
+    """The ``sweep_summary.json`` of the sweep whose results folder is ``results_dir``."""
+    path = Path(results_dir) / SUMMARY_FILE
+    if not path.is_file():
+        raise ValueError(
+            f"--sweep: {str(results_dir)!r} holds no {SUMMARY_FILE}; give the results_dir of a "
+            f"sweep run with python -m agents.sweep"
+        )
+    return json.loads(path.read_text(encoding="utf-8"))
+
+
+def read_sweep(results_dir: str | Path) -> list[SweepTrial]:
+    """Every trial of the sweep whose results folder is ``results_dir``, from its summary."""
+    results_dir = Path(results_dir)
+    summary = read_summary(results_dir)
+    return [
+        SweepTrial(
+            name=entry["name"],
+            values=entry["values"],
+            status=entry["status"],
+            error=entry["error"],
+            folder=results_dir / entry["folder"],
+            scores=entry["scores"],
+        )
+        for entry in summary["trials"]
+    ]
+
+
+def finished_trials(results_dir: str | Path, env_id: str) -> list[SweepTrial]:
+    """The finished trials of a sweep of ``env_id`` (``ValueError`` if the sweep trained
+    another id or has no finished trial)."""
+    summary = read_summary(results_dir)
+    if summary.get("env_id") != env_id:
+        raise ValueError(
+            f"--sweep: {str(results_dir)!r} trained {summary.get('env_id')!r}, not {env_id!r}"
+        )
+    finished = [trial for trial in read_sweep(results_dir) if trial.status == "finished"]
+    if not finished:
+        raise ValueError(f"--sweep: {str(results_dir)!r} has no finished trial")
+    return finished
+
+
+def sweep_models(results_dirs: list[str | Path], env_id: str) -> list[str]:
+    """The model paths of the finished trials of every sweep in ``results_dirs``."""
+    return [
+        str(trial.model)
+        for results_dir in results_dirs
+        for trial in finished_trials(results_dir, env_id)
+    ]

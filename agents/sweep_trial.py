@@ -1,0 +1,83 @@
+"""One trial of a sweep, as Ray Tune runs it: one ``agents.train`` run that reports its
+progress to Tune.
+
+The trial's folder is ``results_dir/trials/<name>`` (:meth:`SweepConfig.trial_name`). A trial
+that Tune restarts after an interruption does not train again if its training had finished
+(an interruption can land between the saved model and Tune's record of the trial's end); else
+it continues from the newest checkpoint in that folder when the training config saves
+checkpoints, or starts again.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from ray import tune
+from stable_baselines3.common.callbacks import BaseCallback
+
+from agents.sweep_config import SweepConfig
+from agents.sweep_results import (
+    EVALUATIONS_FILE,
+    final_scores,
+    last_evaluation,
+    scores,
+    training_finished,
+)
+from agents.train import CHECKPOINT_DIR, latest_checkpoint, train
+
+
+class TuneReportCallback(BaseCallback):
+    """After every rollout but the last, report to Tune the training steps, the mean return of
+    the recent training episodes and the training run's last evaluation against the paper
+    trigger (read from its ``evaluations.json``; see :func:`agents.sweep_results.scores`).
+
+    The last rollout (``total_timesteps`` reached) reports nothing: a scheduler stops a trial
+    that reports its full length, which would end it before its model is saved; the trial
+    reports its final scores after training instead. Nor does a rollout whose scores lack the
+    ``metric`` that the sweep's scheduler or search optimises (Tune refuses such a report),
+    e.g. before the first evaluation."""
+
+    def __init__(
+        self, run_folder: str | Path, total_timesteps: int, metric: str | None = None
+    ) -> None:
+        super().__init__()
+        self.run_folder = Path(run_folder)
+        self.total_timesteps = total_timesteps
+        self.metric = metric
+
+    def _on_step(self) -> bool:
+        return True
+
+    def _on_rollout_end(self) -> None:
+        if self.num_timesteps >= self.total_timesteps:
+            return
+        episodes = self.model.ep_info_buffer
+        reward = float(np.mean([episode["r"] for episode in episodes])) if episodes else None
+        evaluation = None
+        if (self.run_folder / EVALUATIONS_FILE).is_file():
+            evaluation = last_evaluation(self.run_folder)
+        reported = scores(self.num_timesteps, reward, evaluation)
+        if self.metric is None or self.metric in reported:
+            tune.report(reported)
+
+
+def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
+    """Tune's trainable: train the trial with the swept ``values`` into its folder, report as
+    it goes, and report the final scores once the model is saved."""
+    name = sweep.trial_name(values, tune.get_context().get_trial_id())
+    folder = sweep.trial_folder(name)
+    if not training_finished(folder):
+        config = sweep.trial_config(values, folder)
+        resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
+        if not resume:  # an interrupted start's evaluations are not this run's
+            (folder / EVALUATIONS_FILE).unlink(missing_ok=True)
+        reporter = TuneReportCallback(folder, config.total_timesteps, sweep.metric)
+        train(config, resume=resume, callbacks=[reporter])
+    tune.report(final_scores(folder))
+
+
+def trial_dirname(sweep: SweepConfig, trial: Any) -> str:
+    """Tune's folder name of a trial: the same readable name as its results folder."""
+    return sweep.trial_name(trial.config, trial.trial_id)

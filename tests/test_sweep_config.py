@@ -1,0 +1,200 @@
+"""Sweep configs (``configs/sweeps/*.yaml``): validation, grid points, trial names and the
+training config of each trial. No Ray needed."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+pytest.importorskip("stable_baselines3")
+
+from agents.sweep_config import load_sweep_config, sweep_config_from_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+BASE = str(ROOT / "configs" / "train" / "attitude_tracking_ppo.yaml")
+
+
+def sweep(tmp_path: Path, **keys: Any) -> dict[str, Any]:
+    """A valid front over two penalties and two seeds, with ``keys`` replaced."""
+    raw = {
+        "base": BASE,
+        "results_dir": str(tmp_path / "sweep"),
+        "kind": "front",
+        "grid": {"env_kwargs.transmission_penalty": [0.05, 100.0], "seed": [1, 2]},
+    }
+    raw.update(keys)
+    return raw
+
+
+def test_a_grid_gives_every_combination_with_a_readable_name(tmp_path: Path) -> None:
+    config = sweep_config_from_dict(sweep(tmp_path))
+    points = config.grid_points()
+    assert len(points) == 4
+    names = [config.trial_name(point) for point in points]
+    assert names[0] == "transmission_penalty=0.05,seed=1"
+    assert names[-1] == "transmission_penalty=100,seed=2"
+    assert len(set(names)) == 4
+    assert config.trial_folder(names[0]) == tmp_path / "sweep" / "trials" / names[0]
+
+
+def test_keys_that_share_their_last_part_are_named_in_full(tmp_path: Path) -> None:
+    grid = {"env_kwargs.horizon_s": [1.0], "evaluation_env_kwargs.horizon_s": [2.0]}
+    config = sweep_config_from_dict(sweep(tmp_path, grid=grid))
+    (point,) = config.grid_points()
+    assert config.trial_name(point) == "env_kwargs.horizon_s=1,evaluation_env_kwargs.horizon_s=2"
+
+
+def test_a_trial_config_sets_its_values_and_keeps_the_rest_of_the_base(tmp_path: Path) -> None:
+    overrides = {"total_timesteps": 4096, "hyperparameters.n_epochs": 2}
+    config = sweep_config_from_dict(sweep(tmp_path, overrides=overrides))
+    point = config.grid_points()[1]
+    trial = config.trial_config(point, tmp_path / "trial")
+    base = yaml.safe_load(Path(BASE).read_text(encoding="utf-8"))
+    assert trial.env_kwargs["transmission_penalty"] == 0.05
+    assert trial.env_kwargs["cost_scale"] == base["env_kwargs"]["cost_scale"]
+    assert trial.seed == 2
+    assert trial.total_timesteps == 4096
+    assert trial.hyperparameters["n_epochs"] == 2
+    assert trial.hyperparameters["learning_rate"] == base["hyperparameters"]["learning_rate"]
+    assert trial.out_dir == str(tmp_path / "trial")
+
+
+@pytest.mark.parametrize(
+    ("keys", "message"),
+    [
+        ({"grids": {"seed": [1]}}, "unknown sweep key(s) ['grids']"),
+        ({"grid": {"seeds": [1, 2]}}, "unknown training-config key 'seeds'"),
+        ({"grid": {"seed.x": [1, 2]}}, "unknown training-config key 'seed.x'"),
+        ({"overrides": {"total_steps": 10}}, "unknown training-config key 'total_steps'"),
+        ({"grid": {"hyperparameters.n_step": [64]}}, "['n_step'] are not PPO arguments"),
+        ({"grid": {}}, "'grid' and 'search' are both empty"),
+        ({"grid": {"seed": []}}, "'grid.seed' must be a non-empty list"),
+        ({"grid": {"seed": [1, 1]}}, "'grid.seed' repeats a value"),
+        ({"grid": {"seed": [-1]}}, "config key 'seed' must be a non-negative integer"),
+        ({"kind": "pareto"}, "'kind' must be one of ['front', 'search']"),
+        ({"base": "missing.yaml"}, "sweep key 'base': cannot read 'missing.yaml'"),
+        ({"cpus_per_trial": 0}, "'cpus_per_trial' must be a positive number"),
+    ],
+)
+def test_bad_sweep_configs_are_refused_naming_the_key(
+    tmp_path: Path, keys: dict[str, Any], message: str
+) -> None:
+    with pytest.raises(ValueError) as error:
+        sweep_config_from_dict(sweep(tmp_path, **keys))
+    assert message in str(error.value)
+    assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize(
+    "keys",
+    [
+        {"scheduler": "asha", "metric": "cost_ratio", "mode": "min"},
+        {"search": {"hyperparameters.learning_rate": {"loguniform": [1.0e-5, 1.0e-3]}}},
+        {"num_samples": 3},
+    ],
+)
+def test_a_front_is_never_stopped_early_or_sampled(tmp_path: Path, keys: dict[str, Any]) -> None:
+    with pytest.raises(ValueError, match="never stopped early or sampled"):
+        sweep_config_from_dict(sweep(tmp_path, **keys))
+
+
+def test_a_search_may_use_asha_and_optuna_with_an_objective(tmp_path: Path) -> None:
+    search = {
+        "hyperparameters.learning_rate": {"loguniform": [1.0e-5, 1.0e-3]},
+        "hyperparameters.n_epochs": {"randint": [1, 10]},
+        "env_kwargs.transmission_penalty": {"choice": [10.0, 100.0]},
+    }
+    keys = {"kind": "search", "grid": {}, "search": search, "num_samples": 8}
+    objective = {"scheduler": "asha", "search_algorithm": "optuna", "metric": "cost_ratio"}
+    config = sweep_config_from_dict(sweep(tmp_path, **keys, **objective, mode="min"))
+    assert config.num_samples == 8
+    assert (
+        config.trial_name(
+            {
+                "hyperparameters.learning_rate": 1.234567e-4,
+                "hyperparameters.n_epochs": 3,
+                "env_kwargs.transmission_penalty": 10.0,
+            },
+            "abc_00001",
+        )
+        == "learning_rate=0.000123457,n_epochs=3,transmission_penalty=10,trial=abc_00001"
+    )
+    with pytest.raises(ValueError, match="'metric' must be one of"):
+        sweep_config_from_dict(sweep(tmp_path, **keys, scheduler="asha"))
+    with pytest.raises(ValueError, match="'grid' must be empty with search_algorithm"):
+        rate = {"hyperparameters.learning_rate": search["hyperparameters.learning_rate"]}
+        sweep_config_from_dict(sweep(tmp_path, kind="search", **objective, mode="min", search=rate))
+    with pytest.raises(ValueError, match="'cost_ratio' comes from the training run's evalu"):
+        never = {"evaluation_every": 0}
+        sweep_config_from_dict(sweep(tmp_path, **keys, **objective, mode="min", overrides=never))
+    with pytest.raises(ValueError, match=r"must be \[low, high\] with low < high"):
+        bad = {"hyperparameters.learning_rate": {"uniform": [1.0, 0.5]}}
+        sweep_config_from_dict(sweep(tmp_path, kind="search", search=bad))
+    with pytest.raises(ValueError, match="needs low > 0"):
+        bad = {"hyperparameters.learning_rate": {"loguniform": [0.0, 0.5]}}
+        sweep_config_from_dict(sweep(tmp_path, kind="search", search=bad))
+
+
+SHIPPED_FRONTS = sorted(
+    path for path in (ROOT / "configs" / "sweeps").glob("*.yaml") if path.name != "tiny.yaml"
+)
+
+
+def test_a_front_sweep_ships_for_every_id() -> None:
+    env_ids = set()
+    for path in SHIPPED_FRONTS:
+        config = load_sweep_config(path)
+        env_ids.add(config.base["env_id"])
+    import etsc_envs
+
+    assert env_ids == set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
+
+
+@pytest.mark.parametrize("path", SHIPPED_FRONTS, ids=lambda path: path.stem)
+def test_a_shipped_front_crosses_four_penalties_with_three_seeds(path: Path) -> None:
+    config = load_sweep_config(path)
+    assert config.kind == "front"
+    assert len(config.grid["env_kwargs.transmission_penalty"]) >= 4
+    assert len(config.grid["seed"]) >= 3
+    assert Path(config.results_dir).parts[-3:-1] == ("runs", "sweeps")
+
+
+def test_the_package_and_the_tools_do_not_import_ray() -> None:
+    code = (
+        "import sys, etsc_envs, agents.train, agents.pareto, agents.results, agents.sweep\n"
+        "assert 'ray' not in sys.modules, 'ray was imported'\n"
+    )
+    subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True)
+
+
+def test_without_ray_the_sweep_command_says_which_extra_to_install() -> None:
+    code = (
+        "import sys\n"
+        "sys.modules['ray'] = None  # as if Ray were not installed\n"
+        "from agents.sweep import main\n"
+        "main(['--config', 'configs/sweeps/tiny.yaml'])\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert run.returncode == 2
+    assert (
+        run.stderr.strip()
+        .splitlines()[-1]
+        .endswith('Ray Tune is not installed: pip install -e ".[train,sweep]"')
+    )
+
+
+def test_model_paths_are_made_absolute_for_trials_that_run_elsewhere(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "stage1.zip").write_bytes(b"")
+    monkeypatch.chdir(tmp_path)
+    grid = {"init_from": ["stage1.zip"], "seed": [1]}
+    config = sweep_config_from_dict(sweep(tmp_path, grid=grid, results_dir="out"))
+    trial = config.trial_config(config.grid_points()[0], config.trial_folder("t"))
+    assert trial.init_from == str(tmp_path / "stage1.zip")
+    assert config.results_dir == str(tmp_path / "out")

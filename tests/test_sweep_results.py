@@ -1,0 +1,117 @@
+"""A sweep's results folder read back: the reported scores, the summary, and ``agents.pareto`` /
+``agents.results`` on a sweep (``--sweep``). No Ray needed: the folder is built here."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+from stable_baselines3 import PPO
+
+from agents import pareto, results
+from agents.sweep_results import (
+    SweepTrial,
+    final_scores,
+    finished_trials,
+    read_sweep,
+    scores,
+    trial_status,
+    write_summary,
+)
+from agents.vector_adapter import make_sb3_vec_env
+
+ENV_ID = "etsc/AttitudeTracking-v0"
+
+
+def evaluation(learned_cost: float, learned_sent: int, paper_cost: float, paper_sent: int):
+    return {
+        "timesteps": 1024,
+        "learned": {"mean_cost": learned_cost, "transmissions": learned_sent, "failure": None},
+        "paper": {"mean_cost": paper_cost, "transmissions": paper_sent, "failure": None},
+    }
+
+
+def test_scores_compare_the_last_evaluation_with_the_paper_trigger() -> None:
+    reported = scores(2048, -3.5, evaluation(1.1, 30, 1.0, 120))
+    assert reported["timesteps"] == 2048 and reported["training_reward"] == -3.5
+    assert reported["cost_ratio"] == pytest.approx(1.1)
+    assert reported["transmission_ratio"] == pytest.approx(0.25)
+    assert reported["paper_transmissions"] == 120
+    no_paper_cost = scores(2048, None, evaluation(0.5, 30, 0.0, 120))
+    assert "cost_ratio" not in no_paper_cost and "training_reward" not in no_paper_cost
+    assert scores(10, None, None) == {"timesteps": 10}
+
+
+def make_sweep(results_dir: Path) -> None:
+    """A sweep folder of two trials: one finished with a small model, one failed."""
+    finished = results_dir / "trials" / "transmission_penalty=30"
+    failed = results_dir / "trials" / "transmission_penalty=-1"
+    finished.mkdir(parents=True)
+    env = make_sb3_vec_env(ENV_ID, 2, horizon_s=0.05)
+    model = PPO("MlpPolicy", env, n_steps=16, batch_size=32, n_epochs=1, device="cpu", seed=0)
+    model.learn(total_timesteps=32)
+    model.save(finished / "model.zip")
+    summary = {"timesteps": 32, "recent_episodes": [{"return": -1.0}, {"return": -3.0}]}
+    (finished / "train_summary.json").write_text(json.dumps(summary), encoding="utf-8")
+    failed.mkdir(parents=True)
+    error = "ValueError: transmission_penalty must be >= 0, got -1.0"
+    trials = [
+        SweepTrial(
+            "transmission_penalty=30",
+            {"env_kwargs.transmission_penalty": 30.0},
+            trial_status(finished, None),
+            None,
+            finished,
+            final_scores(finished),
+        ),
+        SweepTrial(
+            "transmission_penalty=-1",
+            {"env_kwargs.transmission_penalty": -1.0},
+            trial_status(failed, error),
+            error,
+            failed,
+            None,
+        ),
+    ]
+    write_summary(results_dir, {"env_id": ENV_ID, "kind": "front"}, trials)
+
+
+def test_the_summary_reads_back_and_only_finished_trials_count(tmp_path: Path) -> None:
+    make_sweep(tmp_path / "sweep")
+    summary = json.loads((tmp_path / "sweep" / "sweep_summary.json").read_text("utf-8"))
+    assert summary["counts"] == {"finished": 1, "failed": 1, "incomplete": 0}
+    assert summary["trials"][0]["scores"] == {"timesteps": 32, "training_reward": -2.0}
+    assert trial_status(tmp_path / "sweep" / "trials", None) == "incomplete"
+    trials = read_sweep(tmp_path / "sweep")
+    assert [trial.status for trial in trials] == ["finished", "failed"]
+    assert trials[1].error.startswith("ValueError: transmission_penalty")
+    (finished,) = finished_trials(tmp_path / "sweep", ENV_ID)
+    assert finished.model == tmp_path / "sweep" / "trials" / "transmission_penalty=30" / "model.zip"
+    with pytest.raises(ValueError, match="trained 'etsc/AttitudeTracking-v0', not"):
+        finished_trials(tmp_path / "sweep", "etsc/InnerFormation-v0")
+    with pytest.raises(ValueError, match=r"holds no sweep_summary\.json"):
+        read_sweep(tmp_path)
+
+
+def test_pareto_and_results_read_a_sweep_folder(tmp_path: Path) -> None:
+    sweep = tmp_path / "sweep"
+    make_sweep(sweep)
+    model = str(sweep / "trials" / "transmission_penalty=30" / "model.zip")
+    short = ["--env-arg", "horizon_s=0.05", "--set-size", "2"]
+    assert pareto.main([ENV_ID, "--sweep", str(sweep), *short, "--out", str(tmp_path / "p")]) == 0
+    front = json.loads((tmp_path / "p" / "pareto.json").read_text("utf-8"))
+    assert [point["policy"] for point in front["curves"]["learned"]] == [f"sb3:{model}"]
+    argv = [ENV_ID, "--sweep", str(sweep), "--scenarios", "paper", *short]
+    assert results.main([*argv, "--out", str(tmp_path / "r")]) == 0
+    written = sorted(path.parent.name for path in (tmp_path / "r").rglob("results.json"))
+    assert written == ["transmission_penalty=30"]
+    result = json.loads(
+        (tmp_path / "r" / "transmission_penalty=30" / "results.json").read_text("utf-8")
+    )
+    assert result["models"] == [model]
+    with pytest.raises(SystemExit):
+        results.main([ENV_ID, "--sweep", str(tmp_path), *short])
