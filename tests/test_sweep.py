@@ -71,7 +71,13 @@ def interrupted_sweep(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any
     first_model = results_dir / "trials" / FIRST / "model.zip"
     log = (tmp_path / "interrupted.log").open("w")
     process = subprocess.Popen(
-        sweep_command(config), cwd=ROOT, env=sweep_environment(), stdout=log, stderr=log
+        sweep_command(config),
+        cwd=ROOT,
+        env=sweep_environment(),
+        stdout=log,
+        stderr=log,
+        # a test run started in the background inherits SIGINT ignored; the sweep must not
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.monotonic() + START_TIMEOUT_S
     while not first_model.is_file() and process.poll() is None and time.monotonic() < deadline:
