@@ -114,7 +114,7 @@ def verdict(
     reference. ``reasons`` names every part that fails."""
     reasons = []
     cost_high = cost["iqm_ci95"][1] if cost["iqm_ci95"] else None
-    if cost_high is None or cost_high > cost_max:
+    if cost_high is not None and cost_high > cost_max:
         reasons.append(f"cost ratio upper bound {_number(cost_high)} > {cost_max}")
     if cost.get("worse_where_reference_zero"):
         reasons.append(

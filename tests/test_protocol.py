@@ -226,3 +226,15 @@ def test_evaluate_refuses_a_folder_as_json_path_before_the_work(tmp_path) -> Non
     done = run_cli("etsc/AttitudeTracking-v0", "--policy", "paper", "--json", str(tmp_path))
     assert done.returncode == 2 and "--json must name a file" in done.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_cost_where_the_reference_has_none_fails_the_verdict() -> None:
+    reference = np.array([0.0, 0.0, 1.0, 2.0])
+    tied = paired_ratio(np.array([0.0, 0.0, 1.0, 2.0]), reference)
+    assert tied["worse_where_reference_zero"] == 0 and tied["iqm"] == 1.0
+    sent = {"iqm": 0.5, "iqm_ci95": [0.45, 0.6]}
+    assert verdict(tied, 0, 0, 1.05, sent)["met"]
+    worse = paired_ratio(np.array([0.1, 0.0, 1.0, 2.0]), reference)
+    assert worse["worse_where_reference_zero"] == 1
+    result = verdict(worse, 0, 0, 1.05, sent)
+    assert not result["met"] and "where the reference's is 0" in result["reasons"][0]
