@@ -315,7 +315,9 @@ def drifting_run():
 def test_cost_reward_and_failure_charge(drifting_run):
     radii, costs, rewards, info = (drifting_run[k] for k in ("radii", "costs", "rewards", "info"))
     outside = np.maximum(0.0, np.maximum(radii - 205.0, 195.0 - radii))
-    assert_allclose(costs, STEP_S * outside**2, rtol=1e-12)
+    # the radius comes from compiled code and from np.linalg.norm (BLAS), whose last bits
+    # differ by machine; outside² amplifies them near the shell's edge
+    assert_allclose(costs, STEP_S * outside**2, rtol=1e-10)
     assert_allclose(rewards[:-1], -costs[:-1] / 3.0, rtol=1e-12)
     unwrapped = drifting_run["env"].unwrapped
     cut = unwrapped.n_steps - unwrapped.step_index
