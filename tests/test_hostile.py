@@ -121,7 +121,7 @@ def test_a_vector_parameter_refuses_text() -> None:
 def test_params_must_be_the_envs_parameter_class(env_id: str) -> None:
     with pytest.raises(TypeError) as error:
         gym.make(env_id, params="x")
-    assert_one_line(error, "params")
+    assert_one_line(error, "params of", "Params, got 'x' (str)")
 
 
 def test_horizon_must_be_a_whole_number_of_sampling_periods() -> None:
