@@ -519,7 +519,6 @@ def test_resume_falls_back_past_a_torn_checkpoint(tmp_path: Path, capsys, damage
 def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> None:
     """SIGINT mid-run: one line and status 130, no traceback; ``--resume`` then keeps every
     evaluation up to the checkpoint it continues from."""
-    import os
     import signal
     import subprocess
     import sys
@@ -534,17 +533,20 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
     config_path.write_text(yaml.safe_dump(config), encoding="utf-8")
     command = [sys.executable, "-m", "agents.train", "--config", str(config_path)]
     root = Path(__file__).parents[1]
-    process = subprocess.Popen(
-        command, cwd=root, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-    )
-    evaluations = out_dir / "evaluations.json"
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and process.poll() is None:
-        if evaluations.is_file() and len(_evaluations(out_dir)) >= 4:
-            break
-        time.sleep(0.2)
-    process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=60)
+    log = tmp_path / "stderr.txt"
+    with open(log, "w", encoding="utf-8") as stderr_file:  # a file: a pipe could fill and block
+        process = subprocess.Popen(
+            command, cwd=root, stdout=subprocess.DEVNULL, stderr=stderr_file, text=True
+        )
+        evaluations = out_dir / "evaluations.json"
+        deadline = time.monotonic() + 240
+        while time.monotonic() < deadline and process.poll() is None:
+            if evaluations.is_file() and len(_evaluations(out_dir)) >= 4:
+                break
+            time.sleep(0.2)
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=120)
+    stderr = log.read_text(encoding="utf-8")
     assert process.returncode == 130, stderr
     assert "Traceback" not in stderr, stderr
     assert "--resume" in stderr
@@ -559,8 +561,7 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
         cwd=root,
         capture_output=True,
         text=True,
-        timeout=120,
-        env={**os.environ},
+        timeout=240,
     )
     assert resumed.returncode == 0, resumed.stderr
     after = _evaluations(out_dir)
