@@ -536,7 +536,12 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
     log = tmp_path / "stderr.txt"
     with open(log, "w", encoding="utf-8") as stderr_file:  # a file: a pipe could fill and block
         process = subprocess.Popen(
-            command, cwd=root, stdout=subprocess.DEVNULL, stderr=stderr_file, text=True
+            command,
+            cwd=root,
+            stdout=subprocess.DEVNULL,
+            stderr=stderr_file,
+            # a test run started in the background ignores SIGINT, and so would the child
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
         )
         evaluations = out_dir / "evaluations.json"
         deadline = time.monotonic() + 240
