@@ -287,6 +287,17 @@ def test_evaluate_refuses_a_folder_for_json_before_running(tmp_path: Path, capsy
     assert "--json" in _error_line(capsys)
 
 
+def test_evaluate_refuses_a_plot_folder_under_a_file(tmp_path: Path, capsys) -> None:
+    from baselines.evaluate import main
+
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--policy", "paper", "--plot", str(blocker / "plots")])
+    assert exit_info.value.code == 2
+    assert "--plot" in _error_line(capsys)
+
+
 def test_benchmark_refuses_a_json_path_under_a_file(tmp_path: Path, capsys) -> None:
     from etsc_envs.benchmark import main
 
