@@ -9,14 +9,17 @@ A config is a YAML mapping with these keys (the optional ones show their default
   that the agent does not overfit one trajectory;
 * ``algorithm`` — one of :data:`ALGORITHMS` (``PPO``, ``A2C``, ``DQN``);
 * ``policy`` — an SB3 policy alias of that algorithm, e.g. ``MlpPolicy``;
-* ``hyperparameters: {}`` — keyword arguments of the algorithm's constructor;
+* ``hyperparameters: {}`` — keyword arguments of the algorithm's constructor, each of the
+  kind of its default (a number, true/false); the counts of
+  :data:`POSITIVE_COUNT_HYPERPARAMETERS` are integers >= 1;
 * ``total_timesteps`` — environment steps to train for, summed over the vectorised envs;
 * ``n_envs: 1`` — environments stepped together (in the id's native vector env, one compiled
   call per step);
 * ``seed: 0`` — seeds the algorithm and the environments (``null`` leaves them unseeded);
   environment ``j`` is seeded ``seed + j``, and a seed range that reaches into the protocol's
   validation or test seeds is refused (:func:`etsc_envs.protocol.require_training_seeds`);
-* ``out_dir`` — where the model, the resolved config and the summary are written;
+* ``out_dir`` — where the model, the resolved config and the summary are written (checked
+  to be a writable folder, or one that can be made, before anything runs);
 * ``normalize_observations: true`` — train on observations standardised by running
   statistics (SB3's ``VecNormalize``), saved beside the model for evaluation;
 * ``observation_clip: 10.0`` — normalised observations are clipped to ± this (SB3's
@@ -36,7 +39,8 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``tensorboard: true`` — write TensorBoard logs into ``out_dir/tensorboard``;
 * ``init_from: null`` — a model saved by an earlier run (``model.zip`` or a checkpoint) to
   start from: its weights and, when saved beside it, its observation and return statistics
-  (a curriculum, e.g. short episodes first, then the paper's horizon or another λ);
+  (a curriculum, e.g. short episodes first, then the paper's horizon or another λ); it must
+  have been trained for the observation and action spaces of ``env_id``;
 * ``imitation_steps: 0`` — before reinforcement, run the paper's trigger for that many steps
   on the training envs and clone it into the policy (and its returns into the value
   function; :mod:`agents.imitation`); 0 starts from a random policy;

@@ -31,7 +31,7 @@ from baselines.cli import (
 from baselines.episodes import mean_record
 from baselines.plotting import plot_episode
 from baselines.statistics import aggregate_lines, aggregate_records
-from etsc_envs.core.files import output_file_argument
+from etsc_envs.core.files import output_file_argument, output_folder_argument
 from etsc_envs.protocol import DEFAULT_SET_SIZE, SCENARIO_SET_NAMES, scenario_set
 
 
@@ -147,7 +147,12 @@ def main(argv: list[str] | None = None) -> int:
         type=output_file_argument("--json"),
         help="write the results as JSON",
     )
-    parser.add_argument("--plot", metavar="DIR", help="write one figure per episode")
+    parser.add_argument(
+        "--plot",
+        metavar="DIR",
+        type=output_folder_argument("--plot"),
+        help="write one figure per episode",
+    )
     args = parser.parse_args(argv)
     limit_torch_threads()
     try:

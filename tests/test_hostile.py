@@ -121,7 +121,7 @@ def test_a_vector_parameter_refuses_text() -> None:
 def test_params_must_be_the_envs_parameter_class(env_id: str) -> None:
     with pytest.raises(TypeError) as error:
         gym.make(env_id, params="x")
-    assert_one_line(error, "params")
+    assert_one_line(error, "params of", "Params, got 'x' (str)")
 
 
 def test_horizon_must_be_a_whole_number_of_sampling_periods() -> None:
@@ -285,6 +285,17 @@ def test_evaluate_refuses_a_folder_for_json_before_running(tmp_path: Path, capsy
         main(["etsc/AttitudeTracking-v0", "--policy", "paper", "--json", str(tmp_path)])
     assert exit_info.value.code == 2
     assert "--json" in _error_line(capsys)
+
+
+def test_evaluate_refuses_a_plot_folder_under_a_file(tmp_path: Path, capsys) -> None:
+    from baselines.evaluate import main
+
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--policy", "paper", "--plot", str(blocker / "plots")])
+    assert exit_info.value.code == 2
+    assert "--plot" in _error_line(capsys)
 
 
 def test_benchmark_refuses_a_json_path_under_a_file(tmp_path: Path, capsys) -> None:
@@ -520,7 +531,6 @@ def test_resume_falls_back_past_a_torn_checkpoint(tmp_path: Path, capsys, damage
 def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> None:
     """SIGINT mid-run: one line and status 130, no traceback; ``--resume`` then keeps every
     evaluation up to the checkpoint it continues from."""
-    import os
     import signal
     import subprocess
     import sys
@@ -535,23 +545,25 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
     config_path.write_text(yaml.safe_dump(config), encoding="utf-8")
     command = [sys.executable, "-m", "agents.train", "--config", str(config_path)]
     root = Path(__file__).parents[1]
-    process = subprocess.Popen(
-        command,
-        cwd=root,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        # a test run started in the background inherits SIGINT ignored; the run must not
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-    evaluations = out_dir / "evaluations.json"
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and process.poll() is None:
-        if evaluations.is_file() and len(_evaluations(out_dir)) >= 4:
-            break
-        time.sleep(0.2)
-    process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=60)
+    log = tmp_path / "stderr.txt"
+    with open(log, "w", encoding="utf-8") as stderr_file:  # a file: a pipe could fill and block
+        process = subprocess.Popen(
+            command,
+            cwd=root,
+            stdout=subprocess.DEVNULL,
+            stderr=stderr_file,
+            # a test run started in the background ignores SIGINT, and so would the child
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        )
+        evaluations = out_dir / "evaluations.json"
+        deadline = time.monotonic() + 240
+        while time.monotonic() < deadline and process.poll() is None:
+            if evaluations.is_file() and len(_evaluations(out_dir)) >= 4:
+                break
+            time.sleep(0.2)
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=120)
+    stderr = log.read_text(encoding="utf-8")
     assert process.returncode == 130, stderr
     assert "Traceback" not in stderr, stderr
     assert "--resume" in stderr
@@ -566,8 +578,7 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
         cwd=root,
         capture_output=True,
         text=True,
-        timeout=120,
-        env={**os.environ},
+        timeout=240,
     )
     assert resumed.returncode == 0, resumed.stderr
     after = _evaluations(out_dir)

@@ -7,17 +7,24 @@ inertia-like matrices that are not symmetric positive definite, unknown options)
 (floats, float64 arrays, a renormalised quaternion).
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from etsc_envs.core.validation import (
+    apply_overrides,
+    require_bool,
     require_choice,
+    require_field_types,
     require_non_negative,
     require_positive,
+    require_reset_options,
     require_spd_matrix,
     require_unit_quaternion,
     require_vector,
+    step_count,
 )
 
 BAD_NUMBERS = [np.nan, np.inf, -np.inf]
@@ -139,3 +146,77 @@ def test_require_spd_matrix_accepts():
     result = require_spd_matrix("inertia", SPD.tolist())
     assert result.dtype == np.float64
     assert_array_equal(result, SPD)
+
+
+@pytest.mark.parametrize("value", ["no", "False", 0, 1, None, np.array([True])])
+def test_require_bool_refuses_everything_but_a_bool(value):
+    with pytest.raises(ValueError, match="randomize must be True or False"):
+        require_bool("randomize", value)
+
+
+@pytest.mark.parametrize("value", [True, False, np.True_])
+def test_require_bool_accepts_bools(value):
+    assert require_bool("randomize", value) is bool(value)
+
+
+@pytest.mark.parametrize(
+    ("horizon_s", "period_s", "steps"),
+    [(0.003, 0.001, 3), (300.0, 0.001, 300_000), (0.5, 0.01, 50)],
+)
+def test_step_count_of_whole_horizons(horizon_s, period_s, steps):
+    assert step_count(horizon_s, period_s) == steps
+
+
+@pytest.mark.parametrize(("horizon_s", "period_s"), [(0.0015, 0.001), (0.0004, 0.001)])
+def test_step_count_refuses_a_fraction_of_a_period(horizon_s, period_s):
+    with pytest.raises(ValueError, match="horizon_s must be a whole number"):
+        step_count(horizon_s, period_s)
+
+
+def test_require_reset_options():
+    assert require_reset_options(None) == {}
+    assert require_reset_options({"reset_mask": 1}, ["reset_mask"]) == {"reset_mask": 1}
+    with pytest.raises(ValueError, match=r"unknown key\(s\) \['foo'\].*takes no options"):
+        require_reset_options({"foo": 1})
+    with pytest.raises(ValueError, match="options must be None or a dict"):
+        require_reset_options("string")
+
+
+@dataclasses.dataclass(frozen=True)
+class _Fields:
+    flag: bool = True
+    count: int = 1
+    gain: float = 1.0
+    limit: float | None = None
+    mode: str = "a"
+    vector: tuple = (1.0, 2.0)
+    anything: object = None
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("flag", "no"),
+        ("count", 1.5),
+        ("count", True),
+        ("gain", "1.0"),
+        ("limit", "x"),
+        ("mode", 3),
+        ("vector", "abc"),
+        ("vector", [[1.0], [1.0, 2.0]]),
+    ],
+)
+def test_require_field_types_names_the_field(name, value):
+    with pytest.raises(ValueError, match=name):
+        require_field_types(_Fields(**{name: value}))
+
+
+def test_require_field_types_accepts_fitting_values():
+    require_field_types(_Fields(flag=np.False_, count=np.int64(3), gain=2, limit=None))
+    require_field_types(_Fields(vector=np.zeros(2), anything="free"))
+
+
+def test_apply_overrides_refuses_params_of_another_type():
+    with pytest.raises(TypeError, match=r"params of Owner must be None or a _Fields, got 'x'"):
+        apply_overrides(_Fields, "x", {}, "Owner")
+    assert apply_overrides(_Fields, None, {"gain": 3.0}, "Owner").gain == 3.0

@@ -136,8 +136,10 @@ def require_reset_options(options: Any, allowed: Iterable[str] = ()) -> dict[str
 
 
 def _annotation_names(annotation: Any) -> set[str]:
-    """The type names of a field annotation (a string under postponed evaluation)."""
-    text = annotation if isinstance(annotation, str) else getattr(annotation, "__name__", "")
+    """The type names of a field annotation: a string under postponed evaluation, else a class
+    (its name) or a union such as ``float | None`` (its text)."""
+    text = annotation if isinstance(annotation, type | str) else str(annotation)
+    text = text.__name__ if isinstance(text, type) else text
     return {part.strip() for part in str(text).split("|")}
 
 
