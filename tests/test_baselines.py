@@ -31,9 +31,9 @@ from baselines import reproduce
 from baselines.cli import parse_assignments
 from baselines.episodes import run_episode, to_jsonable
 from baselines.evaluate import evaluate
-from baselines.policies import AlwaysPolicy, PeriodicPolicy, infer_sb3_algorithm, load_sb3
+from baselines.policies import infer_sb3_algorithm, load_sb3
 from baselines.reproductions.report import Scenario, claim, metric_row, render
-from baselines.triggers import PAPER_TRIGGERS, AttitudeTrackingTrigger
+from etsc_envs.triggers import PAPER_TRIGGERS, AlwaysPolicy, AttitudeTrackingTrigger, PeriodicPolicy
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 RECORD_KEYS = {

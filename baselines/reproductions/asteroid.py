@@ -22,7 +22,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
 from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
-from baselines.triggers.asteroid import PAPER_ALPHA
+from etsc_envs.triggers.asteroid import PAPER_ALPHA
 
 PAPER = "003"
 TITLE = "Barrier-based event-triggered orbit keeping near asteroid 25143 Itokawa"

@@ -18,7 +18,7 @@ import numpy as np
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import save
 from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
-from baselines.triggers.inner_formation import AXES, default_thresholds
+from etsc_envs.triggers.inner_formation import AXES, default_thresholds
 
 PAPER = "004"
 TITLE = "Event-triggered disturbance estimation and output feedback, inner formation (Hao 2024)"
