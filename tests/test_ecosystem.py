@@ -90,7 +90,7 @@ def test_pettingzoo_make_honours_max_cycles_with_episode_metrics():
     aec = pettingzoo.make("aec", CLUSTER_ID, max_cycles=2)
     aec.reset(seed=0)
     steps = 0
-    for agent in aec.agent_iter():
+    for _ in aec.agent_iter():
         *_, terminated, truncated, _ = aec.last()
         aec.step(None if terminated or truncated else 0)
         steps += 1

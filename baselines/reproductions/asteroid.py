@@ -350,9 +350,7 @@ def _figures(records: dict, traces: dict, plot_dir: Path) -> list[str]:
 
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run every scenario once and compare with section 4 of the paper."""
-    records, traces = run_scenarios(
-        ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}", progress
-    )
+    records, traces = run_scenarios(ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}")
     tables = [
         {"name": name, "rows": [metric_row(s, paper, records[s]) for s, paper in rows]}
         for name, rows in TABLES.items()

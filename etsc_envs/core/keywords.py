@@ -13,6 +13,7 @@ from __future__ import annotations
 import ast
 import dataclasses
 import inspect
+import itertools
 import textwrap
 from collections.abc import Callable
 from typing import Any, TypeVar
@@ -26,7 +27,7 @@ def field_docs(params_class: type) -> dict[str, str]:
     tree = ast.parse(textwrap.dedent(inspect.getsource(params_class)))
     body = tree.body[0].body
     docs = {field.name: "" for field in dataclasses.fields(params_class)}
-    for statement, following in zip(body, body[1:], strict=False):
+    for statement, following in itertools.pairwise(body):
         if (
             isinstance(statement, ast.AnnAssign)
             and isinstance(statement.target, ast.Name)
