@@ -18,7 +18,11 @@ from baselines.episodes import EpisodeTrace, run_episode
 TEXT_WIDTH = 100
 """Columns the rendered report fits in."""
 LABEL_WIDTH = 44
-"""Columns of the scenario label in a table row (a longer label gets a line of its own)."""
+"""Columns of the scenario label in a table row at most (fewer where the metric names are long;
+a longer label gets lines of its own)."""
+VALUE_COLUMNS = 34
+"""Columns of a row besides the label and the metric name: indent, paper, ours, gap and the
+spaces between."""
 
 
 @dataclass(frozen=True)
@@ -114,19 +118,20 @@ def render(result: dict) -> str:
     for table in result["tables"]:
         lines += ["", *textwrap.wrap(table["name"], TEXT_WIDTH)]
         name_width = max(len(name) for row in table["rows"] for name in row["metrics"])
+        label_width = max(8, min(LABEL_WIDTH, TEXT_WIDTH - VALUE_COLUMNS - name_width))
         lines.append(
-            f"  {'scenario':<{LABEL_WIDTH}s} {'metric':<{name_width}s}"
+            f"  {'scenario':<{label_width}s} {'metric':<{name_width}s}"
             f" {'paper':>10s} {'ours':>10s} {'gap':>8s}"
         )
         for row in table["rows"]:
             label = row["scenario"]
-            if len(label) > LABEL_WIDTH:
-                lines.append(f"  {label}")
+            if len(label) > label_width:
+                lines += textwrap.wrap(label, TEXT_WIDTH, initial_indent="  ")
                 label = ""
             for name, entry in row["metrics"].items():
                 gap = "" if entry["rel_diff"] is None else f"{100 * entry['rel_diff']:+.1f}%"
                 lines.append(
-                    f"  {label:<{LABEL_WIDTH}s} {name:<{name_width}s}"
+                    f"  {label:<{label_width}s} {name:<{name_width}s}"
                     f" {_number(entry['paper']):>10s} {_number(entry['ours']):>10s} {gap:>8s}"
                 )
                 label = ""
