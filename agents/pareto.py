@@ -45,12 +45,12 @@ from agents.sweep_results import sweep_models
 from baselines.cli import limit_torch_threads, parse_assignments, require_policies, write_json
 from baselines.evaluate import evaluate
 from baselines.plotting import save
-from baselines.triggers.asteroid import PAPER_ALPHA
-from baselines.triggers.attitude_tracking import PAPER_PSI
-from baselines.triggers.inner_formation import default_thresholds
-from baselines.triggers.orbit_attitude import PAPER_GAMMA
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.protocol import DEFAULT_SET_SIZE
+from etsc_envs.triggers.asteroid import PAPER_ALPHA
+from etsc_envs.triggers.attitude_tracking import PAPER_PSI
+from etsc_envs.triggers.inner_formation import default_thresholds
+from etsc_envs.triggers.orbit_attitude import PAPER_GAMMA
 
 SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
 """Multiples of the paper's threshold swept where the threshold is a free positive number."""

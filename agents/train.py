@@ -48,6 +48,7 @@ from stable_baselines3.common.callbacks import (
     ProgressBarCallback,
 )
 from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.on_policy_algorithm import OnPolicyAlgorithm
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 
 import etsc_envs
@@ -161,9 +162,17 @@ def _train(
     start = time.perf_counter()
     periodic = _periodic_callbacks(config, out_dir, env.num_envs, checkpoint)
     progress = [ProgressBarCallback()] if _progress_bar_available() else []
+    remaining = max(config.total_timesteps - model.num_timesteps, 0)
+    steps = whole_rollout_steps(remaining, model)
+    if steps != remaining:
+        print(
+            f"training {steps} steps for total_timesteps {remaining}: {type(model).__name__} "
+            f"collects whole rollouts of n_steps x n_envs = {model.n_steps} x {model.n_envs}",
+            flush=True,
+        )
     try:
         model.learn(
-            total_timesteps=max(config.total_timesteps - model.num_timesteps, 0),
+            total_timesteps=steps,
             callback=CallbackList([metrics_callback, *periodic, *callbacks, *progress]),
             reset_num_timesteps=checkpoint is None,
         )
@@ -252,6 +261,16 @@ class AtomicCheckpointCallback(CheckpointCallback):
             self.model.save(buffer)
             atomic_write_bytes(self._checkpoint_path(extension="zip"), buffer.getvalue())
         return True
+
+
+def whole_rollout_steps(timesteps: int, model: BaseAlgorithm) -> int:
+    """The steps ``model.learn(timesteps)`` takes: an on-policy algorithm (PPO, A2C) collects
+    whole rollouts of ``n_steps`` in each of its ``n_envs`` environments, so the budget rounds
+    up to a multiple of ``n_steps * n_envs`` (off-policy algorithms stop at the budget)."""
+    if not isinstance(model, OnPolicyAlgorithm):
+        return timesteps
+    rollout = model.n_steps * model.n_envs
+    return -(-timesteps // rollout) * rollout
 
 
 def latest_checkpoint(folder: Path) -> Path | None:

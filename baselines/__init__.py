@@ -1,1 +1,3 @@
-"""Reference trigger policies (the papers', periodic, always) and the evaluation commands."""
+"""The evaluation and reproduction commands, run from the checkout (``python -m
+baselines.evaluate``); the reference trigger policies they run live in
+:mod:`etsc_envs.triggers`, installed with the package."""

@@ -12,9 +12,9 @@ import yaml
 
 import etsc_envs
 from baselines.episodes import run_episode, run_parallel_episode, to_jsonable
-from baselines.policies import AlwaysPolicy, PeriodicPolicy, load_sb3
-from baselines.triggers import PAPER_TRIGGERS
+from baselines.policies import load_sb3
 from etsc_envs.core.files import atomic_write_text
+from etsc_envs.triggers import PAPER_TRIGGERS, AlwaysPolicy, PeriodicPolicy
 
 POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
 

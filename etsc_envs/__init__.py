@@ -1,10 +1,21 @@
 """etsc-envs: Gymnasium and PettingZoo environments for learning when to communicate in
 event-triggered spacecraft control.
 
-Importing the package registers every environment id (see :data:`ENV_IDS`); the PettingZoo ids
-are listed in :data:`PETTINGZOO_ENV_IDS` and built by :func:`make_parallel` / :func:`make_aec`.
+Importing the package registers every environment id: the Gymnasium ids of :data:`ENV_IDS`
+with Gymnasium, the PettingZoo ids of :data:`PETTINGZOO_ENV_IDS` with PettingZoo's registry,
+as ``"parallel"`` and ``"aec"`` envs::
+
+    import pettingzoo
+
+    import etsc_envs
+
+    env = pettingzoo.make("parallel", "etsc/ClusterContainment-v0", scenario="pi1")
+    aec = pettingzoo.make("aec", "etsc/ClusterContainment-v0", max_cycles=1000)
 """
 
+from typing import Any
+
+import pettingzoo
 from gymnasium.envs.registration import register, registry
 
 ENV_IDS = {
@@ -41,8 +52,14 @@ for _env_id, _entry_point in ENV_IDS.items():
 PETTINGZOO_ENV_IDS = {
     "etsc/ClusterContainment-v0": "etsc_envs.cluster_containment_v0",
 }
-"""PettingZoo id → module with ``parallel_env``, ``env`` and ``raw_env`` (PettingZoo has no
-global registry; use :func:`make_parallel` or :func:`make_aec`)."""
+"""PettingZoo id → module with ``parallel_env``, ``env`` and ``raw_env`` (PettingZoo's module
+convention); the id is registered with ``pettingzoo.register`` for both env types."""
+
+_PETTINGZOO_REGISTRIES = {"parallel": pettingzoo.parallel_registry, "aec": pettingzoo.aec_registry}
+for _env_id, _module in PETTINGZOO_ENV_IDS.items():
+    for _env_type, _function in (("parallel", "parallel_env"), ("aec", "env")):
+        if _env_id not in _PETTINGZOO_REGISTRIES[_env_type]:
+            pettingzoo.register(_env_type, _env_id, f"{_module}:{_function}")
 
 PETTINGZOO_LOOP_IDS = {
     "etsc/ClusterContainment-v0": "etsc/ClusterContainmentCentral-v0",
@@ -51,25 +68,22 @@ PETTINGZOO_LOOP_IDS = {
 transmit bit per agent), whose native vector env trains one policy for all agents."""
 
 
-def _pettingzoo_module(env_id: str):
-    import importlib
-
+def _require_pettingzoo_id(env_id: str) -> str:
     if env_id not in PETTINGZOO_ENV_IDS:
         raise ValueError(f"unknown PettingZoo id {env_id!r}; known: {sorted(PETTINGZOO_ENV_IDS)}")
-    return importlib.import_module(PETTINGZOO_ENV_IDS[env_id])
+    return env_id
 
 
-def make_parallel(env_id: str, **kwargs):
-    """The PettingZoo ``ParallelEnv`` registered as ``env_id``, built with ``kwargs``.
-
-    Example: ``make_parallel("etsc/ClusterContainment-v0", scenario="pi1")``.
-    """
-    return _pettingzoo_module(env_id).parallel_env(**kwargs)
+def make_parallel(env_id: str, **kwargs: Any) -> pettingzoo.ParallelEnv:
+    """``pettingzoo.make("parallel", env_id, **kwargs)`` for an id of this package
+    (``ValueError`` for any other id)."""
+    return pettingzoo.make("parallel", _require_pettingzoo_id(env_id), **kwargs)
 
 
-def make_aec(env_id: str, **kwargs):
-    """The PettingZoo AEC form (with PettingZoo's usual wrappers) of ``env_id``."""
-    return _pettingzoo_module(env_id).env(**kwargs)
+def make_aec(env_id: str, **kwargs: Any) -> pettingzoo.AECEnv:
+    """``pettingzoo.make("aec", env_id, **kwargs)``: the AEC form with PettingZoo's usual
+    wrappers (``ValueError`` for an id not of this package)."""
+    return pettingzoo.make("aec", _require_pettingzoo_id(env_id), **kwargs)
 
 
 __version__ = "0.1.0"

@@ -36,7 +36,6 @@ from gymnasium.utils.env_checker import check_env as gymnasium_check_env
 from numpy.testing import assert_allclose, assert_array_equal
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.triggers import AsteroidOrbitKeepingTrigger
 from etsc_envs.asteroid.controller import thrust_law
 from etsc_envs.asteroid.dynamics import (
     gravity_gradient_force,
@@ -47,6 +46,7 @@ from etsc_envs.asteroid.gravity import GRAVITATIONAL_CONSTANT
 from etsc_envs.asteroid.shape import itokawa_shape, write_obj
 from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import attitude_matrix, quat_from_rotation_vector
+from etsc_envs.triggers import AsteroidOrbitKeepingTrigger
 
 ENV_ID = "etsc/AsteroidOrbitKeeping-v0"
 STEP_S = 0.25

@@ -33,8 +33,8 @@ from gymnasium.utils.env_checker import check_env as gymnasium_check_env
 from numpy.testing import assert_allclose, assert_array_equal
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.triggers import AttitudeTrackingTrigger
 from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
+from etsc_envs.triggers import AttitudeTrackingTrigger
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 PERIOD_S = 0.001

@@ -31,9 +31,9 @@ from baselines import reproduce
 from baselines.cli import parse_assignments
 from baselines.episodes import run_episode, to_jsonable
 from baselines.evaluate import evaluate
-from baselines.policies import AlwaysPolicy, PeriodicPolicy, infer_sb3_algorithm, load_sb3
-from baselines.reproductions.report import Scenario, claim, metric_row, render
-from baselines.triggers import PAPER_TRIGGERS, AttitudeTrackingTrigger
+from baselines.policies import infer_sb3_algorithm, load_sb3
+from baselines.reproductions.report import Scenario, claim, metric_row, render, stages
+from etsc_envs.triggers import PAPER_TRIGGERS, AlwaysPolicy, AttitudeTrackingTrigger, PeriodicPolicy
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 RECORD_KEYS = {
@@ -292,10 +292,39 @@ def test_report_prints_paper_and_our_values():
     }
     text = render(result)
     assert "Paper 002: A tiny table" in text and "Table 1 - sinusoid" in text
-    line = next(line for line in text.splitlines() if "event-triggered Psi=0.1" in line)
-    assert "0.0122" in line and "0.0125" in line and "+2.5%" in line
-    assert "101.2" in line and "/ -" in line
+    lines = text.splitlines()
+    first = next(i for i, line in enumerate(lines) if "event-triggered Psi=0.1" in line)
+    e_v, t_a = lines[first].split(), lines[first + 1].split()
+    assert e_v[-4:] == ["E_v", "0.0122", "0.0125", "+2.5%"]
+    assert t_a == ["T_A_ms", "101.2", "-"]
     assert "[FAILS ] a larger Psi transmits less: 47 vs 417" in text
+
+
+def test_report_fits_100_columns_however_long_its_labels_and_claims():
+    scenario = Scenario("x" * 60, (), "paper")
+    metrics = {f"metric_with_a_long_name_{i}": 1.0 + i for i in range(8)}
+    row = metric_row(scenario, metrics, metrics)
+    result = {
+        "paper": "000",
+        "title": "A long title " * 5,
+        "env": ENV_ID,
+        "tables": [{"name": "A table named at length " * 6, "rows": [row]}],
+        "claims": [claim("a claim " * 20, True, "the evidence " * 20)],
+        "figures": [f"figures/paper_000/figure_{i}.png" for i in range(12)],
+    }
+    lines = render(result).splitlines()
+    assert max(len(line) for line in lines) <= 100
+    assert sum("metric_with_a_long_name_" in line for line in lines) == 8
+    assert sum(line.count("+0.0%") for line in lines) == 8
+
+
+def test_each_finished_run_is_reported_on_standard_error_at_once(capsys):
+    scenarios = [Scenario(label, (), "paper") for label in ("first", "second")]
+    seen = [capsys.readouterr().err for _ in stages(scenarios, "paper 999")]
+    seen.append(capsys.readouterr().err)
+    assert seen[0] == ""  # nothing before the first run ends
+    assert seen[1].startswith("paper 999: run 1/2 done (first)")
+    assert seen[2].startswith("paper 999: run 2/2 done (second)")
 
 
 # --------------------------------------------------------------------------- sb3

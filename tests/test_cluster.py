@@ -43,7 +43,6 @@ from pettingzoo.test import api_test, parallel_api_test
 import etsc_envs
 from baselines.evaluate import evaluate
 from baselines.reproductions import cluster as reproduction
-from baselines.triggers import PAPER_TRIGGERS, ClusterContainmentTrigger
 from etsc_envs import cluster_containment_v0
 from etsc_envs.cluster.closed_loop import integrate_loop
 from etsc_envs.cluster.controller import regressor
@@ -66,6 +65,7 @@ from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
 from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import quat_kinematics, quat_to_mrp
+from etsc_envs.triggers import PAPER_TRIGGERS, ClusterContainmentTrigger
 
 PARALLEL_ID = "etsc/ClusterContainment-v0"
 CENTRAL_ID = "etsc/ClusterContainmentCentral-v0"

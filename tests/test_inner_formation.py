@@ -22,11 +22,11 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.triggers.inner_formation import InnerFormationTrigger, default_thresholds
 from etsc_envs.inner_formation import InnerFormationEnv, InnerFormationParams
 from etsc_envs.inner_formation.closed_loop import loop_derivative
 from etsc_envs.inner_formation.design import estimation_bounds, observer_certificate
 from etsc_envs.inner_formation.dynamics import lumped_term
+from etsc_envs.triggers.inner_formation import InnerFormationTrigger, default_thresholds
 
 ENV_ID = "etsc/InnerFormation-v0"
 

@@ -22,7 +22,7 @@ from pettingzoo.test import parallel_api_test
 
 from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts
 from etsc_envs.core.jit import jit
-from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.loop_env import UNBOUNDED, EventTriggeredEnv
 from etsc_envs.core.multi_agent import (
     EventTriggeredParallelEnv,
     agent_major_names,
@@ -125,7 +125,7 @@ def test_passes_the_pettingzoo_parallel_api_test():
 def test_observations_rewards_and_clocks_per_agent():
     env = EventTriggeredParallelEnv(Integrators())
     assert env.agent_observation_names == ("x", "u", "time_since_transmission_s")
-    assert_array_equal(env.observation_space("integrator_1").low, [-10.0, -np.inf, 0.0])
+    assert_array_equal(env.observation_space("integrator_1").low, [-10.0, -UNBOUNDED, 0.0])
     observations, infos = env.reset(seed=0)
     assert_allclose(observations["integrator_1"], [0.5, 6.0, 0.0])  # held u synchronised
     assert set(infos) == {"integrator_0", "integrator_1"}

@@ -34,8 +34,6 @@ from gymnasium.utils.env_checker import check_env as gymnasium_check_env
 from numpy.testing import assert_allclose, assert_array_equal
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.policies import AlwaysPolicy
-from baselines.triggers import OrbitAttitudeTrigger
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import se3_exp, se3_log
@@ -57,6 +55,7 @@ from etsc_envs.orbit_attitude.env import (
     make_plant_model,
 )
 from etsc_envs.orbit_attitude.params import OrbitAttitudeParams
+from etsc_envs.triggers import AlwaysPolicy, OrbitAttitudeTrigger
 
 ENV_ID = "etsc/OrbitAttitudeTracking-v0"
 SHORT = {"horizon_s": 0.5}

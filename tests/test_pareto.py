@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("stable_baselines3")
 
 from agents.pareto import PAPER_SWEEPS, main, non_dominated, periodic_sweep
-from baselines.triggers.attitude_tracking import PAPER_PSI
+from etsc_envs.triggers.attitude_tracking import PAPER_PSI
 
 
 def test_pareto_writes_the_curves_with_intervals_and_the_paper_scenario(tmp_path: Path) -> None:

@@ -13,7 +13,13 @@ import yaml
 stable_baselines3 = pytest.importorskip("stable_baselines3")
 
 from agents.config import config_from_dict  # noqa: E402
-from agents.train import CONFIG_FILE, MODEL_FILE, SUMMARY_FILE, main  # noqa: E402
+from agents.train import (  # noqa: E402
+    CONFIG_FILE,
+    MODEL_FILE,
+    SUMMARY_FILE,
+    main,
+    whole_rollout_steps,
+)
 
 CONFIG_DIR = Path(__file__).parents[1] / "configs" / "train"
 SHIPPED_CONFIG = CONFIG_DIR / "attitude_tracking_ppo.yaml"
@@ -81,6 +87,18 @@ def test_train_writes_a_loadable_model(tmp_path: Path) -> None:
     observation, _ = env.reset(seed=0)
     action, _ = model.predict(observation, deterministic=True)
     assert env.action_space.contains(int(action))
+
+
+def test_a_budget_of_part_of_a_rollout_says_it_rounds_up(tmp_path: Path, capsys) -> None:
+    config = tiny_config(tmp_path / "run")
+    config["hyperparameters"].update(n_steps=64, batch_size=64)
+    config.update(total_timesteps=300, n_envs=2)  # rollouts of 128 steps: 384 are taken
+    assert main(["--config", str(write_config(config, tmp_path))]) == 0
+    assert "training 384 steps for total_timesteps 300" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "run" / SUMMARY_FILE).read_text(encoding="utf-8"))
+    assert summary["timesteps"] == 384
+    model = stable_baselines3.DQN("MlpPolicy", "CartPole-v1", device="cpu")
+    assert whole_rollout_steps(300, model) == 300
 
 
 def test_config_rejects_an_unknown_algorithm(tmp_path: Path) -> None:

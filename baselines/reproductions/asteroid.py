@@ -22,7 +22,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
 from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
-from baselines.triggers.asteroid import PAPER_ALPHA
+from etsc_envs.triggers.asteroid import PAPER_ALPHA
 
 PAPER = "003"
 TITLE = "Barrier-based event-triggered orbit keeping near asteroid 25143 Itokawa"
@@ -350,9 +350,7 @@ def _figures(records: dict, traces: dict, plot_dir: Path) -> list[str]:
 
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run every scenario once and compare with section 4 of the paper."""
-    records, traces = run_scenarios(
-        ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}", progress
-    )
+    records, traces = run_scenarios(ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}")
     tables = [
         {"name": name, "rows": [metric_row(s, paper, records[s]) for s, paper in rows]}
         for name, rows in TABLES.items()

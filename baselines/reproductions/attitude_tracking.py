@@ -206,9 +206,7 @@ def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str,
     """Run every scenario of Tables 1-3 once and compare with the paper's numbers."""
     scenarios = list(dict.fromkeys(row[0] for rows in TABLES.values() for row in rows))
     sampled = FIGURE_RUNS if plot_dir is not None else ()
-    records, traces = run_scenarios(
-        ENV_ID, scenarios, sampled, SAMPLE_EVERY, f"paper {PAPER}", progress
-    )
+    records, traces = run_scenarios(ENV_ID, scenarios, sampled, SAMPLE_EVERY, f"paper {PAPER}")
     tables = [
         {"name": name, "rows": [metric_row(s, paper, records[s]) for s, paper in rows]}
         for name, rows in TABLES.items()

@@ -17,13 +17,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tqdm import tqdm
 
 import etsc_envs
 from baselines.cli import make_agent_policy
 from baselines.episodes import EpisodeTrace, run_parallel_episode
 from baselines.reproductions.cluster_figures import draw_figures
-from baselines.reproductions.report import Scenario, claim, metric_row
+from baselines.reproductions.report import Scenario, claim, metric_row, stages
 from etsc_envs.cluster.env import hull_distance
 from etsc_envs.cluster.params import FIGURE_5_CELLS
 
@@ -271,7 +270,7 @@ def reproduce(
     """
     sample_every = PLOT_SAMPLE_EVERY if plot_dir is not None else SAMPLE_EVERY
     records, traces, convergence, hull, growth = {}, {}, {}, {}, {}
-    for scenario in tqdm(SCENARIOS, desc=f"paper {PAPER}", disable=not progress, unit="run"):
+    for scenario in stages(SCENARIOS, f"paper {PAPER}"):
         record, trace = run_scenario(scenario, sample_every, horizon_s, progress)
         records[scenario], traces[scenario] = record, trace
         hull[scenario] = hull_entry_times(trace)

@@ -9,7 +9,7 @@ import numpy as np
 
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
-from baselines.triggers.cluster import trigger_threshold
+from etsc_envs.triggers.cluster import trigger_threshold
 
 AXES = ("x", "y", "z")
 TRIGGER_WINDOW_S = 200.0

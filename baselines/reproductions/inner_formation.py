@@ -18,7 +18,7 @@ import numpy as np
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import save
 from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
-from baselines.triggers.inner_formation import AXES, default_thresholds
+from etsc_envs.triggers.inner_formation import AXES, default_thresholds
 
 PAPER = "004"
 TITLE = "Event-triggered disturbance estimation and output feedback, inner formation (Hao 2024)"
@@ -218,9 +218,7 @@ def _figures(traces: dict[Scenario, EpisodeTrace], plot_dir: Path) -> list[str]:
 
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run the four scenarios and compare with Theorem 1, Theorem 3 and section 4's claims."""
-    records, traces = run_scenarios(
-        ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}", progress
-    )
+    records, traces = run_scenarios(ENV_ID, SCENARIOS, FIGURE_RUNS, SAMPLE_EVERY, f"paper {PAPER}")
     empty = {
         "transmissions": None,
         "transmission_rate": None,

@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from baselines.cli import make_policy
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row
+from baselines.reproductions.report import Scenario, claim, metric_row, stages
 from etsc_envs.orbit_attitude.closed_loop import disturbance_step
 from etsc_envs.orbit_attitude.dynamics import thruster_outputs
 
@@ -434,7 +434,7 @@ def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str,
     """Run the four scenarios and compare with section IV's bounds and claims."""
     runs = {
         scenario: run_scenario(scenario, progress)
-        for scenario in tqdm(SCENARIOS, desc=f"paper {PAPER}", disable=not progress, unit="run")
+        for scenario in stages(SCENARIOS, f"paper {PAPER}")
     }
     records = {scenario: run.record for scenario, run in runs.items()}
     tables = [

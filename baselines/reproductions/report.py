@@ -1,17 +1,28 @@
 """The shape of a reproduction: its scenarios and how one runs, the result's rows and claims,
-and their text rendering (paper value beside ours)."""
+and their text rendering (paper value beside ours, within :data:`TEXT_WIDTH` columns)."""
 
 from __future__ import annotations
 
-from collections.abc import Container, Iterable
+import sys
+import textwrap
+import time
+from collections.abc import Container, Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
 import gymnasium as gym
-from tqdm import tqdm
 
 from baselines.cli import make_policy
 from baselines.episodes import EpisodeTrace, run_episode
+
+TEXT_WIDTH = 100
+"""Columns the rendered report fits in."""
+LABEL_WIDTH = 44
+"""Columns of the scenario label in a table row at most (fewer where the metric names are long;
+a longer label gets lines of its own)."""
+VALUE_COLUMNS = 34
+"""Columns of a row besides the label and the metric name: indent, paper, ours, gap and the
+spaces between."""
 
 
 @dataclass(frozen=True)
@@ -37,19 +48,35 @@ def run_scenario(
     return record, trace
 
 
+def stages(scenarios: Iterable[Scenario], description: str) -> Iterator[Scenario]:
+    """Yield ``scenarios``; after each one's run, write a line saying so to standard error
+    (flushed, so that a long reproduction shows its progress when its output is redirected)."""
+    scenarios = list(scenarios)
+    start = time.perf_counter()
+    for index, scenario in enumerate(scenarios, start=1):
+        yield scenario
+        elapsed_s = time.perf_counter() - start
+        print(
+            f"{description}: run {index}/{len(scenarios)} done ({scenario.label}), "
+            f"{elapsed_s:.0f} s",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
 def run_scenarios(
     env_id: str,
     scenarios: Iterable[Scenario],
     sampled: Container[Scenario],
     sample_every: int,
     description: str,
-    progress: bool = False,
 ) -> tuple[dict[Scenario, dict[str, Any]], dict[Scenario, EpisodeTrace]]:
     """Run each scenario once (those in ``sampled`` storing states every ``sample_every``
-    steps) and return the episode records and traces by scenario."""
+    steps), reporting each finished run (:func:`stages`), and return the episode records and
+    traces by scenario."""
     records: dict[Scenario, dict[str, Any]] = {}
     traces: dict[Scenario, EpisodeTrace] = {}
-    for scenario in tqdm(list(scenarios), desc=description, disable=not progress, unit="run"):
+    for scenario in stages(scenarios, description):
         every = sample_every if scenario in sampled else None
         records[scenario], traces[scenario] = run_scenario(env_id, scenario, every)
     return records, traces
@@ -79,31 +106,43 @@ def claim(statement: str, holds: bool, detail: str) -> dict:
     return {"claim": statement, "holds": bool(holds), "detail": detail}
 
 
+def _number(value: float | None) -> str:
+    return "-" if value is None else f"{value:.4g}"
+
+
 def render(result: dict) -> str:
-    """Plain-text tables: for every row and metric, ``paper  ours  (gap %)``."""
-    lines = [f"Paper {result['paper']}: {result['title']}  [{result['env']}]"]
+    """Plain-text tables within :data:`TEXT_WIDTH` columns: one line per scenario and metric,
+    ``paper  ours  gap``, then the paper's claims."""
+    heading = f"Paper {result['paper']}: {result['title']}"
+    lines = [*textwrap.wrap(heading, TEXT_WIDTH), f"  [{result['env']}]"]
     for table in result["tables"]:
-        lines += ["", table["name"]]
-        names = list(table["rows"][0]["metrics"])
-        width = max(32, *(len(n) + 20 for n in names))
-        header = f"  {'scenario':<34s}" + "".join(
-            f"{n + ' paper/ours (gap)':>{width}s}" for n in names
+        lines += ["", *textwrap.wrap(table["name"], TEXT_WIDTH)]
+        name_width = max(len(name) for row in table["rows"] for name in row["metrics"])
+        label_width = max(8, min(LABEL_WIDTH, TEXT_WIDTH - VALUE_COLUMNS - name_width))
+        lines.append(
+            f"  {'scenario':<{label_width}s} {'metric':<{name_width}s}"
+            f" {'paper':>10s} {'ours':>10s} {'gap':>8s}"
         )
-        lines.append(header)
         for row in table["rows"]:
-            cells = []
-            for name in names:
-                entry = row["metrics"][name]
-                gap = "" if entry["rel_diff"] is None else f" ({100 * entry['rel_diff']:+.1f}%)"
-                ours = "-" if entry["ours"] is None else f"{entry['ours']:.4g}"
-                paper = "-" if entry["paper"] is None else f"{entry['paper']:.4g}"
-                cells.append(f"{paper:>10s} / {ours:<8s}{gap:>10s}")
-            lines.append(f"  {row['scenario']:<34s}" + "".join(f"{c:>{width}s}" for c in cells))
+            label = row["scenario"]
+            if len(label) > label_width:
+                lines += textwrap.wrap(label, TEXT_WIDTH, initial_indent="  ")
+                label = ""
+            for name, entry in row["metrics"].items():
+                gap = "" if entry["rel_diff"] is None else f"{100 * entry['rel_diff']:+.1f}%"
+                lines.append(
+                    f"  {label:<{label_width}s} {name:<{name_width}s}"
+                    f" {_number(entry['paper']):>10s} {_number(entry['ours']):>10s} {gap:>8s}"
+                )
+                label = ""
     if result.get("claims"):
         lines += ["", "Claims of the paper"]
         for item in result["claims"]:
             mark = "holds " if item["holds"] else "FAILS "
-            lines.append(f"  [{mark}] {item['claim']}: {item['detail']}")
+            text = f"[{mark}] {item['claim']}: {item['detail']}"
+            lines += textwrap.wrap(
+                text, TEXT_WIDTH, initial_indent="  ", subsequent_indent="           "
+            )
     if result.get("figures"):
-        lines += ["", "Figures: " + ", ".join(result["figures"])]
+        lines += ["", *textwrap.wrap("Figures: " + ", ".join(result["figures"]), TEXT_WIDTH)]
     return "\n".join(lines)

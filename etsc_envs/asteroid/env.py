@@ -61,6 +61,7 @@ from etsc_envs.asteroid.gravity import GRAVITATIONAL_CONSTANT
 from etsc_envs.asteroid.gravity_grid import collides
 from etsc_envs.asteroid.params import AsteroidParams
 from etsc_envs.asteroid.shape import ShapeModel
+from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.rotations import (
     error_quaternion,
@@ -97,6 +98,11 @@ FEATURE_NAMES = (
 * ``burst_remaining_s`` — time left in the running burst (0 when none);
 * ``clearance_m`` — height above the surface interpolated from the gravity grid (within
   √3 × grid spacing of the exact distance; measured within 1.5 m for the packaged grid).
+
+Bounds: positions, radius and clearance within twice the operating region's outer radius
+(leaving the region ends the episode), the burst flags within their ranges; the velocities and
+the products with them are unbounded (±``UNBOUNDED``): nothing in the paper bounds the speed a
+transient or a burst may reach before the episode ends.
 """
 
 RANDOM_AZIMUTH_DEG = 5.0
@@ -127,6 +133,7 @@ def sun_pointing(sun_azimuth_deg: float) -> tuple[np.ndarray, np.ndarray]:
     return direction, desired
 
 
+@document_keywords(AsteroidParams)
 class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
     """Barrier-triggered orbit keeping near asteroid Itokawa (paper 003).
 
@@ -167,6 +174,7 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
         decision_interval: int = 1,
         shape: str | Path | ShapeModel | None = None,
         shape_length_unit_m: float | None = None,
+        render_mode: str | None = None,
         **overrides: Any,
     ) -> None:
         self.params = p = apply_overrides(
@@ -235,6 +243,7 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
             cost_scale=cost_scale,
             randomize=randomize,
             failure_cost=worst_outside**2 * decision_period,
+            render_mode=render_mode,
         )
         self._point_at_sun(p.sun_azimuth_deg)
         start = self._initial_state(

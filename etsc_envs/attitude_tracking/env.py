@@ -38,6 +38,7 @@ from etsc_envs.attitude_tracking.dynamics import (
     tracking_error,
 )
 from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
+from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector
 from etsc_envs.core.validation import apply_overrides
@@ -57,6 +58,10 @@ FEATURE_NAMES = (
 * ``z_*`` — the measurement x_1 = z = ω_e + K q_ev itself (rad/s);
 * ``x2_hat_*`` — the ESO's estimate of the total disturbance x_2 (rad/s²);
 * ``trigger_statistic`` — Σ_i Σ_j |α_ji(e_1i, σ_i)| / ε_min, what eq. (27) compares with Ψ.
+
+Bounds: ``trigger_statistic`` >= 0; the others are unbounded (±``UNBOUNDED``): the paper bounds
+e_1, σ and x̂_2 only ultimately (Theorem 1, constants not stated), and z until the divergence
+bound ends the episode, when the last observation may exceed it.
 """
 
 RANDOM_ATTITUDE_MAX_ANGLE_RAD = np.deg2rad(60.0)
@@ -67,6 +72,7 @@ Remark 2 says converges to a small range around zero, is at most this. The paper
 ends at 0.005 rad/s with every sample transmitted; the band is six times that."""
 
 
+@document_keywords(AttitudeTrackingParams)
 class AttitudeTrackingEnv(EventTriggeredEnv):
     """Quaternion attitude tracking with an event-triggered ESO (paper 002).
 
@@ -94,6 +100,7 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
         transmission_penalty: float = 0.1,
         cost_scale: float = 0.01,
         randomize: bool = False,
+        render_mode: str | None = None,
         **overrides: Any,
     ) -> None:
         self.params = apply_overrides(
@@ -145,6 +152,7 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
             cost_scale=cost_scale,
             randomize=randomize,
             failure_cost=p.max_rate_rad_s,
+            render_mode=render_mode,
         )
 
     @property

@@ -42,6 +42,7 @@ from etsc_envs.cluster.closed_loop import (
 from etsc_envs.cluster.dynamics import ClusterModel
 from etsc_envs.cluster.params import ClusterContainmentParams, replace_params
 from etsc_envs.cluster.topology import containment_targets
+from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.multi_agent import agent_major_names, agent_metrics
 from etsc_envs.core.vector_env import EventTriggeredVectorEnv
@@ -71,6 +72,10 @@ FEATURE_NAMES = (
 * ``sigma_*``, ``omega_*`` — the follower's MRP attitude (rad) and body rate (rad/s);
 * ``containment_error_*`` — σ_i - σ_d,i, the offset from its containment target (eq. 8);
 * ``u_*`` — the control held since its last event (eq. 16), N·m.
+
+Bounds: σ, ω and the containment error within the failure bounds, u within the torque limit,
+t within the horizon, the norms >= 0; the norms' upper bounds are unbounded (±``UNBOUNDED``):
+the adaptive gains of eqs. (20)-(21) grow without a stated limit, and e_J with them.
 """
 
 PERIODIC_TERMS = 4
@@ -113,6 +118,7 @@ def hull_distance(point: np.ndarray, vertices: np.ndarray) -> float:
     return float(np.linalg.norm(vertices.T @ weights - point))
 
 
+@document_keywords(ClusterContainmentParams)
 class ClusterContainmentCentralEnv(EventTriggeredEnv):
     """Attitude containment of a microsatellite cluster with one central trigger (paper 001).
 
@@ -143,6 +149,7 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
         transmission_penalty: float = 0.1,
         cost_scale: float = 1.0,
         randomize: bool = False,
+        render_mode: str | None = None,
         **overrides: Any,
     ) -> None:
         self.params = replace_params(params, overrides)
@@ -170,6 +177,7 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
             cost_scale=cost_scale,
             randomize=randomize,
             failure_cost=n * error_bound,
+            render_mode=render_mode,
         )
 
     @property

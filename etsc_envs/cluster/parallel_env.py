@@ -13,14 +13,18 @@ from typing import Any, ClassVar
 
 from etsc_envs.cluster.env import ClusterContainmentCentralEnv
 from etsc_envs.cluster.params import ClusterContainmentParams
+from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.multi_agent import EventTriggeredParallelEnv
+from etsc_envs.core.render import RENDER_MODES
 
 
+@document_keywords(ClusterContainmentParams)
 class ClusterContainmentEnv(EventTriggeredParallelEnv):
     """Attitude containment of a microsatellite cluster, one trigger per follower (paper 001).
 
     Takes the arguments of :class:`ClusterContainmentCentralEnv` (``params``,
-    ``transmission_penalty``, ``cost_scale``, ``randomize`` and any parameter override).
+    ``transmission_penalty``, ``cost_scale``, ``randomize``, ``render_mode`` and any parameter
+    override) and PettingZoo's ``max_cycles`` (truncate after that many steps).
 
     Each agent acts with ``Discrete(2)`` (1: its follower samples, computes eq. (19) and updates
     its actuator) and observes the components of
@@ -30,7 +34,8 @@ class ClusterContainmentEnv(EventTriggeredParallelEnv):
 
     metadata: ClassVar[dict[str, Any]] = {
         "name": "cluster_containment_v0",
-        "render_modes": [],
+        "render_modes": list(RENDER_MODES),
+        "render_fps": 10,
         "is_parallelizable": True,
     }
 
@@ -41,6 +46,8 @@ class ClusterContainmentEnv(EventTriggeredParallelEnv):
         transmission_penalty: float = 0.1,
         cost_scale: float = 1.0,
         randomize: bool = False,
+        render_mode: str | None = None,
+        max_cycles: int | None = None,
         **overrides: Any,
     ) -> None:
         super().__init__(
@@ -49,8 +56,10 @@ class ClusterContainmentEnv(EventTriggeredParallelEnv):
                 transmission_penalty=transmission_penalty,
                 cost_scale=cost_scale,
                 randomize=randomize,
+                render_mode=render_mode,
                 **overrides,
-            )
+            ),
+            max_cycles=max_cycles,
         )
 
     @property

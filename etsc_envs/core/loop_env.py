@@ -8,6 +8,12 @@ transmission_penalty * (channels sent)``. A failure (divergence, non-finite stat
 terminates the episode with ``info["failure"]`` and charges ``failure_cost`` for each step
 left to the horizon.
 
+Observation bounds are the problem's where the physics bounds a component (the failure bounds,
+norms, clocks); a component the paper bounds only asymptotically, by constants it does not
+state (observer estimates, sliding variables, trigger statistics), gets ±:data:`UNBOUNDED`, the
+largest float32, and its problem says so in its ``FEATURE_NAMES`` docs. ``render_mode=
+"rgb_array"`` draws the episode so far (:mod:`etsc_envs.core.render`).
+
 A problem subclasses :class:`EventTriggeredEnv`, sets the class attribute ``kernels`` (its
 :class:`~etsc_envs.core.compiled_loop.ProblemKernels`) and implements four Python hooks:
 ``_reset_problem`` (write the initial state row from ``self.np_random``),
@@ -35,13 +41,19 @@ from etsc_envs.core.compiled_loop import (
     make_loop_step,
 )
 from etsc_envs.core.metrics import communication_metrics
+from etsc_envs.core.render import RENDER_MODES, EpisodeTrace, draw_frame
 from etsc_envs.core.validation import (
     require_bool,
+    require_choice,
     require_non_negative,
     require_positive,
     require_reset_options,
     step_count,
 )
+
+UNBOUNDED = float(np.finfo(np.float32).max)
+"""The bound of an observation component without a physical one: the largest finite float32
+(a finite bound keeps the spaces' checkers and samplers well defined)."""
 
 
 class EventTriggeredEnv(gym.Env):
@@ -64,13 +76,15 @@ class EventTriggeredEnv(gym.Env):
             ending an episode by diverging never pays more than staying in control.
         randomize: whether ``_reset_problem`` draws the episode's start (``True``/``False``
             only).
+        render_mode: ``None`` or ``"rgb_array"`` (:meth:`render` then draws the accuracy cost
+            and the transmission instants of the episode so far).
 
     ``reset()`` takes the ``options`` keys of :attr:`reset_options` (none by default) and
     refuses others. An env can be pickled at any point (the compiled entry is rebuilt on the
     next step) and the copy continues exactly as the original would.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": list(RENDER_MODES), "render_fps": 10}
     kernels: ClassVar[ProblemKernels]
     loop_step: ClassVar[Callable[..., None]]
     reset_options: ClassVar[tuple[str, ...]] = ()
@@ -97,8 +111,11 @@ class EventTriggeredEnv(gym.Env):
         cost_scale: float,
         failure_cost: float,
         randomize: bool = False,
+        render_mode: str | None = None,
     ) -> None:
         self.randomize = require_bool("randomize", randomize)
+        self.render_mode = require_choice("render_mode", render_mode, (None, *RENDER_MODES))
+        self._trace = EpisodeTrace(n_channels) if render_mode is not None else None
         self.sampling_period_s = require_positive("sampling_period_s", sampling_period_s)
         self.horizon_s = require_positive("horizon_s", horizon_s)
         self.n_steps = step_count(self.horizon_s, self.sampling_period_s)
@@ -117,10 +134,9 @@ class EventTriggeredEnv(gym.Env):
         )
         self.observation_names: tuple[str, ...] = tuple(feature_names) + clock_names
         self.n_features = len(feature_names)
-        low = np.concatenate([feature_low, np.zeros(n_channels)]).astype(np.float32)
-        high = np.concatenate([feature_high, np.full(n_channels, self.horizon_s)]).astype(
-            np.float32
-        )
+        low = np.concatenate([feature_low, np.zeros(n_channels)])
+        high = np.concatenate([feature_high, np.full(n_channels, self.horizon_s)])
+        low, high = (bound.clip(-UNBOUNDED, UNBOUNDED).astype(np.float32) for bound in (low, high))
         self.observation_space = gym.spaces.Box(low=low, high=high, dtype=np.float32)
         self.action_space = (
             gym.spaces.Discrete(2) if n_channels == 1 else gym.spaces.MultiBinary(n_channels)
@@ -228,6 +244,8 @@ class EventTriggeredEnv(gym.Env):
             array[0] = 0
         arrays.interevent_min_s[0] = np.inf
         self._reset_problem(options or None)
+        if self._trace is not None:
+            self._trace.clear()
         arrays.held[0] = self._initial_held()
         features = np.empty(self.n_features)
         self.kernels.features(self.state, self.constants, features)
@@ -260,6 +278,7 @@ class EventTriggeredEnv(gym.Env):
         if self._loop_step_entry is None:
             self._loop_step_entry = compiled_entry(self.loop_step, *arguments)
         self._loop_step_entry(*arguments)
+        self.trace_step()
         terminated = bool(arrays.failure_code[0] != 0)
         truncated = bool(not terminated and arrays.step_index[0] >= self.n_steps)
         return (
@@ -303,6 +322,30 @@ class EventTriggeredEnv(gym.Env):
             and self._settled_at_end(paper_metrics)
         )
         return record
+
+    # ----------------------------------------------------------------- rendering
+    def trace_step(self) -> None:
+        """Note the step just taken for :meth:`render` (nothing unless rendering)."""
+        if self._trace is not None:
+            self._trace.record(self.time_s, float(self.arrays.cost[0]), self.arrays.sent[0])
+
+    def render(self) -> np.ndarray | None:
+        """With ``render_mode="rgb_array"``, the episode so far as an RGB array: the accuracy
+        cost per step over time and each channel's transmission instants; ``None`` otherwise."""
+        if self._trace is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array'")
+            return None
+        transmissions = int(self.transmissions.sum())
+        title = f"{type(self).__name__}   t = {self.time_s:.3f} s   transmissions = {transmissions}"
+        return draw_frame(self._trace, self.channel_labels, title)
+
+    @property
+    def channel_labels(self) -> tuple[str, ...]:
+        """One name per channel (the agents' names where the loop has agents)."""
+        names = getattr(self, "agent_names", None)
+        if names is not None:
+            return tuple(names)
+        return ("channel",) if self.n_channels == 1 else tuple(map(str, range(self.n_channels)))
 
     # ----------------------------------------------------------------- internals
     def _set_transmit_bits(self, action: Any) -> None:

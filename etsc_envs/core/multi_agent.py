@@ -33,6 +33,7 @@ from pettingzoo import ParallelEnv
 from etsc_envs.core.compiled_loop import LoopArrays
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.metrics import interevent_summary
+from etsc_envs.core.render import RENDER_MODES
 from etsc_envs.core.validation import require_reset_options
 
 CLOCK_NAME = "time_since_transmission_s"
@@ -87,26 +88,35 @@ class EventTriggeredParallelEnv(ParallelEnv):
     """Decentralised transmit-or-hold decisions over one shared multi-channel loop.
 
     Args:
-        loop: the shared closed loop (see the module docstring for what it must provide).
+        loop: the shared closed loop (see the module docstring for what it must provide); its
+            ``render_mode`` is the env's, and :meth:`render` draws the loop.
+        max_cycles: truncate every episode after this many steps (PettingZoo's keyword;
+            ``None``: at the loop's horizon only).
 
     Agents: ``loop.agent_names``. Each acts with ``Discrete(2)`` (1 transmits its channel) and
     observes ``agent_observation_names``: its features followed by
     ``time_since_transmission_s``. ``state()`` is the loop's whole observation. All agents
     end together: terminated on a failure of the loop (``infos[agent]["failure"]``), truncated
-    at the horizon; the last infos also hold ``episode_metrics``.
+    at the horizon or after ``max_cycles`` steps; the last infos also hold ``episode_metrics``.
     """
 
     metadata: ClassVar[dict[str, Any]] = {
         "name": "event_triggered_parallel_v0",
-        "render_modes": [],
+        "render_modes": list(RENDER_MODES),
+        "render_fps": 10,
         "is_parallelizable": True,
     }
 
-    def __init__(self, loop: EventTriggeredEnv) -> None:
+    def __init__(self, loop: EventTriggeredEnv, max_cycles: int | None = None) -> None:
+        if max_cycles is not None and (
+            isinstance(max_cycles, bool) or not isinstance(max_cycles, int) or max_cycles < 1
+        ):
+            raise ValueError(f"max_cycles must be None or an integer >= 1, got {max_cycles!r}")
         self.loop = loop
+        self.max_cycles = max_cycles
         self.possible_agents = list(loop.agent_names)
         self.agents: list[str] = []
-        self.render_mode = None
+        self.render_mode = loop.render_mode
         self.agent_observation_names = (*loop.agent_feature_names, CLOCK_NAME)
         self._index = agent_observation_index(loop)
         box = loop.observation_space
@@ -144,6 +154,10 @@ class EventTriggeredParallelEnv(ParallelEnv):
         bits = self._bits(actions)
         loop = self.loop
         observation, _, terminated, truncated, info = loop.step(bits)
+        if not (terminated or truncated) and self.max_cycles is not None:
+            truncated = loop.step_index >= self.max_cycles
+            if truncated:
+                info["episode_metrics"] = loop.episode_metrics()
         sent = loop.arrays.sent[0]
         costs = loop.channel_costs
         rewards = loop.channel_rewards
@@ -173,6 +187,11 @@ class EventTriggeredParallelEnv(ParallelEnv):
     def state(self) -> np.ndarray:
         """The loop's whole observation at the current instant (every agent's view)."""
         return self._state.copy()
+
+    def render(self) -> np.ndarray | None:
+        """The loop's frame (``render_mode="rgb_array"``): the accuracy cost and every agent's
+        transmission instants so far."""
+        return self.loop.render()
 
     def close(self) -> None:
         self.loop.close()

@@ -30,6 +30,7 @@ from gymnasium.vector.utils import batch_space
 
 from etsc_envs.core.compiled_loop import allocate_loop_arrays, compiled_entry, loop_rows
 from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.render import RENDER_MODES
 from etsc_envs.core.validation import require_reset_options
 
 ROWS_PER_THREAD_MIN = 8
@@ -66,6 +67,8 @@ class EventTriggeredVectorEnv(VectorEnv):
         num_envs: number of sub-environments (>= 1).
         autoreset_mode: ``"next_step"`` (default), ``"same_step"`` or ``"disabled"`` (or the
             :class:`gymnasium.vector.AutoresetMode` itself).
+        render_mode: ``None`` or ``"rgb_array"``: :meth:`render` then returns one frame per
+            sub-environment (see :meth:`EventTriggeredEnv.render`).
         **env_kwargs: passed to every sub-environment's constructor.
 
     Subclasses set ``single_env_class``; ``envs`` holds the sub-environments (for their
@@ -73,7 +76,8 @@ class EventTriggeredVectorEnv(VectorEnv):
     """
 
     metadata: ClassVar[dict[str, Any]] = {
-        "render_modes": [],
+        "render_modes": list(RENDER_MODES),
+        "render_fps": 10,
         "autoreset_mode": AutoresetMode.NEXT_STEP,
     }
     single_env_class: ClassVar[type[EventTriggeredEnv]]
@@ -83,6 +87,7 @@ class EventTriggeredVectorEnv(VectorEnv):
         num_envs: int = 1,
         *,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        render_mode: str | None = None,
         **env_kwargs: Any,
     ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer):
@@ -93,14 +98,17 @@ class EventTriggeredVectorEnv(VectorEnv):
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.autoreset_mode = mode
         self.num_envs = int(num_envs)
-        self.envs = [self.single_env_class(**env_kwargs) for _ in range(self.num_envs)]
+        self.envs = [
+            self.single_env_class(render_mode=render_mode, **env_kwargs)
+            for _ in range(self.num_envs)
+        ]
         first = self.envs[0]
         self.arrays = allocate_loop_arrays(self.num_envs, *first.loop_shape)
         self.single_observation_space = first.observation_space
         self.single_action_space = first.action_space
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.render_mode = None
+        self.render_mode = first.render_mode
         self._bind_rows()
         self._actions = np.zeros((self.num_envs, first.n_channels), dtype=np.int64)
         self._needs_reset = np.ones(self.num_envs, dtype=bool)
@@ -178,6 +186,9 @@ class EventTriggeredVectorEnv(VectorEnv):
             for index in np.flatnonzero(resetting):
                 self.envs[index].reset()
         self._advance_rows(~resetting)
+        if self.render_mode is not None:
+            for index in np.flatnonzero(~resetting):
+                self.envs[index].trace_step()
         terminated = arrays.failure_code != 0
         truncated = ~terminated & (arrays.step_index >= first.n_steps)
         ended = terminated | truncated
@@ -202,6 +213,12 @@ class EventTriggeredVectorEnv(VectorEnv):
             self._needs_reset = ended
         infos.update(self._step_infos())
         return arrays.observation.copy(), rewards, terminated, truncated, infos
+
+    def render(self) -> tuple[np.ndarray, ...] | None:
+        """One frame per sub-environment with ``render_mode="rgb_array"``, else ``None``."""
+        if self.render_mode is None:
+            return None
+        return tuple(env.render() for env in self.envs)
 
     def close_extras(self, **kwargs: Any) -> None:
         if self._pool is not None:

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.validation import apply_overrides
 from etsc_envs.core.vector_env import EventTriggeredVectorEnv
@@ -53,6 +54,10 @@ FEATURE_NAMES = (
 * ``position_m_*`` — the measurement r_i(t) at the sensor;
 * ``position_estimate_m_*``, ``velocity_estimate_mps_*``, ``disturbance_estimate_mps2_*`` —
   the observer states ζ_i, ψ_i, φ_i of eq. (3).
+
+Bounds: the sampling errors within ±2R and the positions within ±R (R the cavity radius:
+leaving the cavity ends the episode); the observer states are unbounded (±``UNBOUNDED``): the
+paper bounds their errors only ultimately (eqs. 8-10), and its high-gain transient is not.
 """
 
 STEADY_FRACTION = 0.2
@@ -72,6 +77,7 @@ def steady_start_step(params: InnerFormationParams) -> int:
     return int(np.floor((1.0 - STEADY_FRACTION) * n_steps))
 
 
+@document_keywords(InnerFormationParams)
 class InnerFormationEnv(EventTriggeredEnv):
     """Inner-formation relative motion with per-axis event-triggered ESOs (paper 004).
 
@@ -97,6 +103,7 @@ class InnerFormationEnv(EventTriggeredEnv):
         transmission_penalty: float = 0.05,
         cost_scale: float = 1e-3,
         randomize: bool = False,
+        render_mode: str | None = None,
         **overrides: Any,
     ) -> None:
         self.params = apply_overrides(InnerFormationParams, params, overrides, "InnerFormationEnv")
@@ -136,6 +143,7 @@ class InnerFormationEnv(EventTriggeredEnv):
             cost_scale=cost_scale,
             randomize=randomize,
             failure_cost=p.cavity_radius_m,
+            render_mode=render_mode,
         )
 
     @property

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector, se3_exp
 from etsc_envs.core.validation import apply_overrides
@@ -81,6 +82,10 @@ FEATURE_NAMES = (
 * ``dw_*``, ``dv_*`` — Ṽ = [Δω (rad/s), Δv (m/s)], the velocity error of eq. (7).
 
 Eq. (21) reads ē_c1, ē_c2, S̄1 and S̄2 at the controller, the triggering side.
+
+Bounds: Φ within ±π (the principal logarithm); the others are unbounded (±``UNBOUNDED``): the
+paper bounds S, η̃ and Ṽ only in finite time after an unstated transient, and e_c by the
+thrusters' saturation only after the allocation, not in these body-frame components.
 """
 
 COST_REFERENCE = np.array([np.deg2rad(4e-4), np.deg2rad(2e-3), 1e-5, 2e-6])
@@ -223,6 +228,7 @@ def make_loop_constants(params: OrbitAttitudeParams) -> LoopConstants:
     )
 
 
+@document_keywords(OrbitAttitudeParams)
 class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
     """Coupled orbit-attitude tracking with an event-triggered control channel (paper 000).
 
@@ -253,6 +259,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         transmission_penalty: float = 1.0,
         cost_scale: float = 1.0,
         randomize: bool = False,
+        render_mode: str | None = None,
         **overrides: Any,
     ) -> None:
         self.params = apply_overrides(
@@ -279,6 +286,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             cost_scale=cost_scale,
             randomize=randomize,
             failure_cost=float(tracking_cost(failure_eta, failure_twist, COST_REFERENCE)),
+            render_mode=render_mode,
         )
 
     # ----------------------------------------------------------------- the episode's loop

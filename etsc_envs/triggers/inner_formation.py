@@ -7,9 +7,9 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.policies import TriggerPolicy
 from etsc_envs.inner_formation.design import equal_share_thresholds
 from etsc_envs.inner_formation.params import InnerFormationParams
+from etsc_envs.triggers.base import TriggerPolicy
 
 AXES = ("x", "y", "z")
 

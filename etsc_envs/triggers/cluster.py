@@ -7,7 +7,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.policies import TriggerPolicy
+from etsc_envs.triggers.base import TriggerPolicy
 
 PAPER_C, PAPER_RHO, PAPER_NU = 0.6, 2.0, 0.5
 """c_i, ρ_i, ν_i of section 5.1 (the same for every follower)."""

@@ -7,7 +7,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.policies import TriggerPolicy
+from etsc_envs.triggers.base import TriggerPolicy
 
 PAPER_PSI = 0.1
 """Ψ of Tables 1-3's first event-triggered rows (the paper also runs 1.5 and 2.5)."""

@@ -7,7 +7,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.policies import TriggerPolicy
+from etsc_envs.triggers.base import TriggerPolicy
 
 PAPER_ALPHA = 0.05
 """α of eq. (15) in section 4, m²/s."""

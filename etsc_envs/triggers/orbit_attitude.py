@@ -7,7 +7,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.policies import TriggerPolicy
+from etsc_envs.triggers.base import TriggerPolicy
 
 PAPER_A = (0.6, 0.8)
 """a1, a2 of section IV (Theorem 2 needs K21 = 3.2 > a1 and K22 = 3.6 > a2)."""

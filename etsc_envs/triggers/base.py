@@ -1,0 +1,100 @@
+"""Trigger policies that answer like Stable-Baselines3 models.
+
+Every policy has ``predict(obs, state=None, episode_start=None, deterministic=True) ->
+(action, state)`` and accepts one observation or a batch (leading axis), so a single evaluator
+runs paper triggers, periodic schedules and trained models alike. :class:`TriggerPolicy` is the
+base of the papers' rules (:mod:`etsc_envs.triggers`); :class:`AlwaysPolicy` and
+:class:`PeriodicPolicy` are the time-triggered references.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+
+def _n_bits(action_space: gym.Space) -> int | None:
+    """Transmit bits per action: ``None`` for Discrete(2), ``n`` for MultiBinary(n)."""
+    if isinstance(action_space, gym.spaces.Discrete) and action_space.n == 2:
+        return None
+    if isinstance(action_space, gym.spaces.MultiBinary):
+        return int(np.prod(action_space.shape))
+    raise ValueError(f"action_space must be Discrete(2) or MultiBinary(n), got {action_space}")
+
+
+def _batched(obs: np.ndarray, observation_space: gym.Space) -> tuple[np.ndarray, bool]:
+    """``obs`` with a leading batch axis, and whether the caller gave a single observation."""
+    obs = np.asarray(obs)
+    single = obs.shape == observation_space.shape
+    return (obs[None] if single else obs), single
+
+
+class TriggerPolicy:
+    """Base of the analytic trigger policies: maps transmit decisions to the action space.
+
+    Subclasses implement :meth:`transmit`, returning booleans of shape ``(batch,)`` for
+    ``Discrete(2)`` or ``(batch, n_channels)`` for ``MultiBinary``.
+    """
+
+    def __init__(self, observation_space: gym.Space, action_space: gym.Space) -> None:
+        self.observation_space = observation_space
+        self.action_space = action_space
+        self.n_bits = _n_bits(action_space)
+
+    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
+        raise NotImplementedError
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        """Transmit decision(s) for ``observation`` in the Stable-Baselines3 calling convention."""
+        obs, single = _batched(observation, self.observation_space)
+        if episode_start is not None:
+            state = self.reset_state(state, np.asarray(episode_start, dtype=bool), len(obs))
+        decision, state = self.transmit(obs, state)
+        action = decision.astype(np.int64)
+        return (action[0] if single else action), state
+
+    def reset_state(self, state: Any, episode_start: np.ndarray, batch: int) -> Any:
+        """State after episodes restart where ``episode_start`` is set (stateless by default)."""
+        return state
+
+
+class AlwaysPolicy(TriggerPolicy):
+    """Transmit on every channel at every sampling instant (the time-triggered loop at t_s)."""
+
+    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
+        shape = (len(obs),) if self.n_bits is None else (len(obs), self.n_bits)
+        return np.ones(shape, dtype=bool), state
+
+
+class PeriodicPolicy(TriggerPolicy):
+    """Transmit every ``every`` sampling instants, starting with the first (time-triggered).
+
+    The step counters are the recurrent ``state`` of the SB3 convention; pass
+    ``episode_start`` (or ``state=None`` at a reset) to restart them.
+    """
+
+    def __init__(self, observation_space: gym.Space, action_space: gym.Space, every: int = 1):
+        super().__init__(observation_space, action_space)
+        if int(every) != every or every < 1:
+            raise ValueError(f"every must be an integer >= 1 (sampling instants), got {every!r}")
+        self.every = int(every)
+
+    def reset_state(self, state: Any, episode_start: np.ndarray, batch: int) -> Any:
+        counters = np.zeros(batch, dtype=np.int64) if state is None else np.array(state)
+        counters[episode_start] = 0
+        return counters
+
+    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
+        counters = np.zeros(len(obs), dtype=np.int64) if state is None else np.asarray(state)
+        decision = counters % self.every == 0
+        if self.n_bits is not None:
+            decision = np.repeat(decision[:, None], self.n_bits, axis=1)
+        return decision, counters + 1
