@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 
-def _n_bits(action_space: gym.Space) -> int | None:
+def transmit_bits(action_space: gym.Space) -> int | None:
     """Transmit bits per action: ``None`` for Discrete(2), ``n`` for MultiBinary(n)."""
     if isinstance(action_space, gym.spaces.Discrete) and action_space.n == 2:
         return None
@@ -26,7 +26,7 @@ def _n_bits(action_space: gym.Space) -> int | None:
     raise ValueError(f"action_space must be Discrete(2) or MultiBinary(n), got {action_space}")
 
 
-def _batched(obs: np.ndarray, observation_space: gym.Space) -> tuple[np.ndarray, bool]:
+def batched_observations(obs: np.ndarray, observation_space: gym.Space) -> tuple[np.ndarray, bool]:
     """``obs`` with a leading batch axis, and whether the caller gave a single observation."""
     obs = np.asarray(obs)
     single = obs.shape == observation_space.shape
@@ -43,7 +43,7 @@ class TriggerPolicy:
     def __init__(self, observation_space: gym.Space, action_space: gym.Space) -> None:
         self.observation_space = observation_space
         self.action_space = action_space
-        self.n_bits = _n_bits(action_space)
+        self.n_bits = transmit_bits(action_space)
 
     def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
         raise NotImplementedError
@@ -56,7 +56,7 @@ class TriggerPolicy:
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
         """Transmit decision(s) for ``observation`` in the Stable-Baselines3 calling convention."""
-        obs, single = _batched(observation, self.observation_space)
+        obs, single = batched_observations(observation, self.observation_space)
         if episode_start is not None:
             state = self.reset_state(state, np.asarray(episode_start, dtype=bool), len(obs))
         decision, state = self.transmit(obs, state)
@@ -139,8 +139,13 @@ def read_model_record(path: str | Path) -> dict[str, Any]:
     return record
 
 
+MASKABLE_POLICY_MODULE = "sb3_contrib.common.maskable.policies"
+"""The module of the policies of sb3-contrib's ``MaskablePPO`` (what its saves record)."""
+
+
 def infer_sb3_algorithm(path: str | Path) -> type:
-    """The SB3 algorithm class that saved ``path``, read from the zip's ``data`` record.
+    """The SB3 algorithm class that saved ``path``, read from the zip's ``data`` record
+    (sb3-contrib's ``MaskablePPO`` included).
 
     Off-policy algorithms save a policy of their own module (``stable_baselines3.dqn.policies``);
     PPO and A2C share ``stable_baselines3.common.policies`` and differ by PPO's ``clip_range``.
@@ -150,6 +155,10 @@ def infer_sb3_algorithm(path: str | Path) -> type:
     data = read_model_record(path)
     policy_class = data["policy_class"]
     module = getattr(policy_class, "__module__", "")
+    if module == MASKABLE_POLICY_MODULE:
+        from sb3_contrib import MaskablePPO
+
+        return MaskablePPO
     if module == "stable_baselines3.common.policies":
         algorithm_name = "PPO" if "clip_range" in data else "A2C"
     else:
@@ -263,10 +272,18 @@ class NormalizedModel:
         state: Any = None,
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
+        action_masks: np.ndarray | None = None,
     ) -> tuple[np.ndarray, Any]:
+        """The model's ``predict`` on normalised observations (``action_masks`` is passed on
+        when given, for sb3-contrib's ``MaskablePPO``)."""
         normalized = self.normalization.normalize_obs(np.asarray(observation, dtype=np.float32))
+        masks = {} if action_masks is None else {"action_masks": action_masks}
         return self.model.predict(
-            normalized, state=state, episode_start=episode_start, deterministic=deterministic
+            normalized,
+            state=state,
+            episode_start=episode_start,
+            deterministic=deterministic,
+            **masks,
         )
 
 

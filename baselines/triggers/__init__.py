@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
-from baselines.triggers.asteroid import AsteroidOrbitKeepingTrigger
-from baselines.triggers.attitude_tracking import AttitudeTrackingTrigger
-from baselines.triggers.cluster import ClusterContainmentTrigger
-from baselines.triggers.inner_formation import InnerFormationTrigger
-from baselines.triggers.orbit_attitude import OrbitAttitudeTrigger
+from collections.abc import Callable
+
+from baselines.triggers.asteroid import PAPER_ALPHA, AsteroidOrbitKeepingTrigger
+from baselines.triggers.attitude_tracking import PAPER_PSI, AttitudeTrackingTrigger
+from baselines.triggers.cluster import PAPER_C, ClusterContainmentTrigger
+from baselines.triggers.inner_formation import (
+    InnerFormationShield,
+    InnerFormationTrigger,
+    default_thresholds,
+)
+from baselines.triggers.orbit_attitude import PAPER_GAMMA, OrbitAttitudeTrigger
 
 PAPER_TRIGGERS = {
     "etsc/AttitudeTracking-v0": AttitudeTrackingTrigger,
@@ -17,3 +23,24 @@ PAPER_TRIGGERS = {
     "etsc/AsteroidOrbitKeeping-v0": AsteroidOrbitKeepingTrigger,
 }
 """Environment id → the paper's trigger policy class."""
+
+
+def _inner_formation_thresholds() -> dict[str, float]:
+    pi1, pi2, pi3 = default_thresholds()
+    return {"pi1": float(pi1), "pi2": float(pi2), "pi3": float(pi3)}
+
+
+PAPER_THRESHOLDS: dict[str, Callable[[], dict[str, float]]] = {
+    "etsc/AttitudeTracking-v0": lambda: {"psi": PAPER_PSI},
+    "etsc/OrbitAttitudeTracking-v0": lambda: {"gamma1": PAPER_GAMMA[0], "gamma2": PAPER_GAMMA[1]},
+    "etsc/ClusterContainment-v0": lambda: {"c": PAPER_C},
+    "etsc/ClusterContainmentCentral-v0": lambda: {"c": PAPER_C},
+    "etsc/InnerFormation-v0": _inner_formation_thresholds,
+    "etsc/AsteroidOrbitKeeping-v0": lambda: {"alpha": PAPER_ALPHA},
+}
+"""Environment id → the keywords of its paper trigger that set how much error it tolerates
+before transmitting, at the paper's values (a larger value transmits less)."""
+
+PAPER_SHIELDS = {"etsc/InnerFormation-v0": InnerFormationShield}
+"""Environment id → the class of its shield (:class:`InnerFormationShield`'s interface): the
+ids whose papers give a condition under which a hold is unsafe."""
