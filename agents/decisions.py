@@ -66,10 +66,10 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         unwrapped = env.unwrapped
         self.decisions = DecisionSet(
             env.spec.id,
-            max_exponent,
-            default_factors(env.spec.id) if factors is None else tuple(factors),
-            shield_multiple,
-            float(unwrapped.params.sampling_period_s),
+            max_exponent=max_exponent,
+            factors=default_factors(env.spec.id) if factors is None else tuple(factors),
+            shield_multiple=shield_multiple,
+            sampling_period_s=float(unwrapped.params.sampling_period_s),
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names

@@ -78,14 +78,15 @@ class DecisionSet:
         factors: the scalings f > 0 of the paper's threshold, one action each.
         shield_multiple: the shield's bound (for 004, sampling errors within this many Π), or
             ``None`` for no shield.
-        sampling_period_s: the env's sampling period (what the shield converts holds with).
+        sampling_period_s: the env's sampling period (s), which the shield converts holds
+            with; needed with ``shield_multiple``.
     """
 
     env_id: str
     max_exponent: int = DEFAULT_MAX_EXPONENT
     factors: tuple[float, ...] = DEFAULT_FACTORS
     shield_multiple: float | None = None
-    sampling_period_s: float = 0.001
+    sampling_period_s: float | None = None
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -97,11 +98,15 @@ class DecisionSet:
         if not all(np.isfinite(f) and f > 0.0 for f in factors):
             raise ValueError(f"factors must be finite numbers > 0, got {self.factors!r}")
         object.__setattr__(self, "factors", factors)
-        if self.shield_multiple is not None and self.env_id not in PAPER_SHIELDS:
+        if self.shield_multiple is None:
+            return
+        if self.env_id not in PAPER_SHIELDS:
             raise ValueError(
                 f"shield_multiple: no shield for {self.env_id}; shields exist for "
                 f"{sorted(PAPER_SHIELDS)}"
             )
+        if self.sampling_period_s is None:
+            raise ValueError("sampling_period_s must be given with shield_multiple")
 
     @property
     def hold_steps(self) -> np.ndarray:
