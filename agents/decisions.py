@@ -6,8 +6,9 @@ threshold scaled by f. The wrapper runs the interval on the unchanged env and re
 observation of the next decision instant. Its reward is the interval's rewards discounted
 within it, ``sum_i gamma**i * r_i`` over the ``n`` instants it ran, and ``info["elapsed_steps"]
 = n``, so that an algorithm discounting the next decision by ``gamma**n`` keeps the meaning of
-the per-instant return (Stable-Baselines3 discounts every decision by one constant ``gamma``;
-with ``gamma`` close to 1 over an interval the difference is small). ``action_masks()`` gives the
+the per-instant return: Stable-Baselines3 discounts every decision by one constant ``gamma``
+unless it trains with the buffers and callback of :mod:`agents.elapsed_discount` and the same
+``gamma`` as the wrapper's. ``action_masks()`` gives the
 shield's mask for sb3-contrib's ``MaskablePPO``; an unsafe action given anyway is replaced as
 :meth:`~baselines.self_triggered.IntervalSchedule.shielded` says (``info["action"]`` is the one
 run). A model trained here deploys as a transmit/hold policy once its decision set is saved
@@ -40,7 +41,8 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             :func:`~baselines.self_triggered.default_factors`).
         shield_multiple: the shield's bound, or ``None`` for no shield (ids with a shield:
             :data:`baselines.triggers.PAPER_SHIELDS`).
-        gamma: the per-instant discount within an interval (in (0, 1]).
+        gamma: the per-instant discount within an interval (in (0, 1]); the algorithm's
+            ``gamma`` when it discounts by elapsed instants.
     """
 
     def __init__(
