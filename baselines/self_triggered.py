@@ -146,6 +146,24 @@ class DecisionSet:
             raise ValueError(f"decision set {path} is not readable ({error})") from None
 
 
+def scaled_paper_trigger(
+    env_id: str,
+    factor: float,
+    observation_space: gym.Space,
+    action_space: gym.Space,
+    observation_names: tuple[str, ...],
+) -> Any:
+    """The paper trigger of ``env_id`` with its threshold keywords
+    (:data:`~baselines.triggers.PAPER_THRESHOLDS`) scaled by ``factor``; ``ValueError`` naming
+    ``factors`` when the scaled values leave the trigger's range."""
+    thresholds = PAPER_THRESHOLDS[env_id]()
+    scaled = {name: factor * value for name, value in thresholds.items()}
+    try:
+        return PAPER_TRIGGERS[env_id](observation_space, action_space, observation_names, **scaled)
+    except ValueError as error:
+        raise ValueError(f"factors: {factor:g} x the paper's threshold: {error}") from None
+
+
 class IntervalSchedule:
     """The per-instant semantics of a :class:`DecisionSet` for a batch of rows.
 
@@ -166,14 +184,9 @@ class IntervalSchedule:
     ) -> None:
         self.decisions = decisions
         self.n_bits = transmit_bits(action_space)
-        trigger_class = PAPER_TRIGGERS[decisions.env_id]
-        thresholds = PAPER_THRESHOLDS[decisions.env_id]()
         self.triggers = [
-            trigger_class(
-                observation_space,
-                action_space,
-                observation_names,
-                **{name: factor * value for name, value in thresholds.items()},
+            scaled_paper_trigger(
+                decisions.env_id, factor, observation_space, action_space, observation_names
             )
             for factor in decisions.factors
         ]

@@ -172,6 +172,18 @@ def test_bad_arguments_name_themselves(kwargs, argument):
         SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.05), **kwargs)
 
 
+def test_factors_outside_the_trigger_range_name_themselves():
+    env = gym.make("etsc/ClusterContainmentCentral-v0", horizon_s=0.05)
+    with pytest.raises(ValueError, match="factors: 2 x"):
+        SelfTriggeredWrapper(env, factors=(1.0, 2.0))
+
+
+def test_an_unreadable_decision_set_names_its_file(tmp_path):
+    (tmp_path / "model_decisions.json").write_text("{not json")
+    with pytest.raises(ValueError, match=r"model_decisions\.json"):
+        DecisionSet.load(tmp_path / "model.zip")
+
+
 def test_shield_only_where_the_paper_gives_one():
     with pytest.raises(ValueError, match="shield_multiple"):
         DecisionSet(ATTITUDE, shield_multiple=2.0)
