@@ -7,6 +7,7 @@ runs paper triggers, periodic schedules and trained models alike.
 
 from __future__ import annotations
 
+import inspect
 import pickle
 import warnings
 import zipfile
@@ -285,6 +286,13 @@ class NormalizedModel:
             deterministic=deterministic,
             **masks,
         )
+
+
+def takes_action_masks(model: Any) -> bool:
+    """Whether ``model.predict`` takes ``action_masks`` (sb3-contrib's ``MaskablePPO``, also
+    inside a :class:`NormalizedModel`)."""
+    inner = model.model if isinstance(model, NormalizedModel) else model
+    return "action_masks" in inspect.signature(inner.predict).parameters
 
 
 def load_sb3(

@@ -27,7 +27,6 @@ beside ``NAME.zip`` (:meth:`DecisionSet.save`); ``--policy sb3:NAME.zip`` then l
 
 from __future__ import annotations
 
-import inspect
 import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -36,7 +35,12 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.policies import batched_observations, load_sb3, transmit_bits
+from baselines.policies import (
+    batched_observations,
+    load_sb3,
+    takes_action_masks,
+    transmit_bits,
+)
 from baselines.triggers import PAPER_SHIELDS, PAPER_THRESHOLDS, PAPER_TRIGGERS
 from etsc_envs.core.files import atomic_write_text
 
@@ -290,7 +294,7 @@ class SelfTriggeredPolicy:
 
     def choose(self, obs: np.ndarray, deterministic: bool = True) -> np.ndarray:
         """The model's (shielded) actions at decision instants with observations ``obs``."""
-        if self.schedule.shield is not None and _takes_masks(self.model):
+        if self.schedule.shield is not None and takes_action_masks(self.model):
             masks = self.schedule.masks(obs)
             actions, _ = self.model.predict(obs, deterministic=deterministic, action_masks=masks)
         else:
@@ -318,11 +322,6 @@ class SelfTriggeredPolicy:
         decision, state = self.schedule.transmit(obs, state)
         action = decision.astype(np.int64)
         return (action[0] if single else action), state
-
-
-def _takes_masks(model: Any) -> bool:
-    """Whether ``model.predict`` accepts ``action_masks`` (sb3-contrib's ``MaskablePPO``)."""
-    return "action_masks" in inspect.signature(model.predict).parameters
 
 
 def load_self_triggered(

@@ -214,3 +214,57 @@ def test_short_training_saves_reloads_and_evaluates(tmp_path, algorithm):
         single = evaluate(FORMATION, f"sb3:{path}", env_args=env_args, seed=record["seed"])
         assert record["transmissions"] == single["episodes"][0]["transmissions"] > 0
         assert record["mean_cost"] == pytest.approx(single["episodes"][0]["mean_cost"])
+
+
+def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
+    import yaml
+
+    from agents.train import main
+
+    out_dir = tmp_path / "run"
+    config = {
+        "env_id": FORMATION,
+        "env_kwargs": {"horizon_s": 0.1},
+        "algorithm": "MaskablePPO",
+        "policy": "MlpPolicy",
+        "hyperparameters": {"n_steps": 32, "batch_size": 32, "n_epochs": 1, "gamma": 0.999},
+        "total_timesteps": 64,
+        "out_dir": str(out_dir),
+        "decisions": {"max_exponent": 3, "shield_multiple": 2.0},
+        "evaluation_every": 32,
+        "evaluation_scenarios": 2,
+        "evaluation_env_kwargs": {"horizon_s": 0.1},
+        "checkpoint_every": 32,
+        "tensorboard": False,
+    }
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    assert main(["--config", str(path)]) == 0
+    for name in ("model", "best_model", "checkpoints/model_32_steps"):
+        assert DecisionSet.load(out_dir / f"{name}.zip").shield_multiple == 2.0
+    result = evaluate(FORMATION, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
+    assert result["episodes"][0]["transmissions"] > 0
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"algorithm": "MaskablePPO"}, "MaskablePPO needs the key 'decisions'"),
+        ({"decisions": {"max_exponent": 3, "holds": 2}}, "'decisions'"),
+        ({"decisions": {"shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
+        ({"decisions": {}, "imitation_steps": 64}, "imitation_steps"),
+    ],
+)
+def test_training_config_checks_the_decisions(tmp_path, changes, message):
+    from agents.config import config_from_dict
+
+    config = {
+        "env_id": FORMATION,
+        "env_kwargs": {"horizon_s": 0.1},
+        "algorithm": "PPO",
+        "policy": "MlpPolicy",
+        "total_timesteps": 64,
+        "out_dir": str(tmp_path / "run"),
+    }
+    with pytest.raises(ValueError, match=message):
+        config_from_dict({**config, **changes})
