@@ -13,7 +13,7 @@ from agents.decisions import SelfTriggeredWrapper
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.evaluate import evaluate
-from baselines.policies import PeriodicPolicy
+from baselines.policies import PeriodicPolicy, load_sb3, takes_action_masks
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
 from baselines.triggers import PAPER_TRIGGERS
 from baselines.triggers.inner_formation import InnerFormationShield
@@ -208,6 +208,7 @@ def test_short_training_saves_reloads_and_evaluates(tmp_path, algorithm):
     env = gym.make(FORMATION, horizon_s=0.1)
     policy = make_policy(f"sb3:{path}", env, {}, FORMATION)
     assert isinstance(policy, SelfTriggeredPolicy)
+    assert takes_action_masks(policy.model) == (algorithm == "MaskablePPO")
     env_args = {"horizon_s": 0.1}
     batch = evaluate(FORMATION, f"sb3:{path}", env_args=env_args, episodes=2, seed=SEED)
     for record in batch["episodes"]:
@@ -242,6 +243,7 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
     assert main(["--config", str(path)]) == 0
     for name in ("model", "best_model", "checkpoints/model_32_steps"):
         assert DecisionSet.load(out_dir / f"{name}.zip").shield_multiple == 2.0
+    assert takes_action_masks(load_sb3(out_dir / "model.zip"))  # normalised MaskablePPO
     result = evaluate(FORMATION, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
     assert result["episodes"][0]["transmissions"] > 0
 

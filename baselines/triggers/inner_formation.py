@@ -71,8 +71,9 @@ class InnerFormationShield:
     """Which holds keep every axis' sampling error within ``multiple`` × Π_i.
 
     Theorem 1's bounds (8)-(10) are proved for sampling errors |r_i(t) - r_i(t_k)| ≤ Π_i, which
-    eqs. (4)-(6) enforce; they grow linearly with Π_i (:mod:`etsc_envs.inner_formation.design`),
-    so sampling errors kept within m Π_i keep the bounds within m times the paper's. A hold of h
+    eqs. (4)-(6) enforce, and grow with Π_i (:mod:`etsc_envs.inner_formation.design`): sampling
+    errors kept within m Π_i keep the estimation errors within the bounds of the thresholds
+    m Π_i. A hold of h
     after a transmission is called unsafe when its first-order sampling error
     (:func:`predicted_sampling_error`) passes m Π_i on some axis; the paper's own rule with its
     thresholds scaled by f keeps the error within f Π_i (one sampling period's motion aside), so
