@@ -79,6 +79,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.gamma = float(gamma)
         self.action_space = self.decisions.action_space
         self._observation: np.ndarray | None = None
+        self._hold_action = np.zeros(env.action_space.shape, dtype=np.int64)
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -107,12 +108,18 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         state = self.schedule.start(chosen)
         total, steps = 0.0, 0
         while True:
-            decision, state = self.schedule.transmit(obs, state)
-            observation, reward, terminated, truncated, info = self.env.step(
-                decision[0].astype(np.int64)
-            )
-            total += self.gamma**steps * float(reward)
-            steps += 1
+            held = int(self.schedule.unconditional_holds(state)[0])
+            actions = [self._hold_action] * held
+            if not held:
+                decision, state = self.schedule.transmit(obs, state)
+                actions = [decision[0].astype(np.int64)]
+            for action_now in actions:
+                observation, reward, terminated, truncated, info = self.env.step(action_now)
+                total += self.gamma**steps * float(reward)
+                steps += 1
+                if terminated or truncated:
+                    break
+            state = state + np.array([0, held])
             obs = observation[None]
             if terminated or truncated or self.schedule.interval_over(obs, state)[0]:
                 break

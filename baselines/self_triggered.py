@@ -256,6 +256,14 @@ class IntervalSchedule:
         rule_over = (elapsed >= decisions.hold_steps[-1]) | ((elapsed >= 1) & fires)
         return np.where(holding, elapsed >= hold_length, rule_over)
 
+    def unconditional_holds(self, state: np.ndarray) -> np.ndarray:
+        """Per row, the instants from the current one on that hold whatever is observed: the
+        rest of a hold interval after its transmission; 0 elsewhere."""
+        action, elapsed = state[:, 0], state[:, 1]
+        holding = (action < self.decisions.n_holds) & (elapsed >= 1)
+        length = self.decisions.hold_steps[np.minimum(action, self.decisions.n_holds - 1)]
+        return np.where(holding, length - elapsed, 0)
+
     def transmit(self, obs: np.ndarray, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Each row's transmit decision at the instant of ``obs`` (booleans, one column per
         channel for ``MultiBinary``) and the state after it."""
