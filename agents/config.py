@@ -7,7 +7,8 @@ A config is a YAML mapping with these keys (the optional ones show their default
   agents, each agent one sub-environment; ``n_envs`` counts copies of the whole system);
 * ``env_kwargs: {}`` — passed to ``gym.make``; ``randomize`` defaults to ``true`` in training so
   that the agent does not overfit one trajectory;
-* ``algorithm`` — one of :data:`ALGORITHMS` (``PPO``, ``A2C``, ``DQN``);
+* ``algorithm`` — one of :data:`ALGORITHMS` (``PPO``, ``A2C``, ``DQN``, and sb3-contrib's
+  ``MaskablePPO``, which needs ``decisions``);
 * ``policy`` — an SB3 policy alias of that algorithm, e.g. ``MlpPolicy``;
 * ``hyperparameters: {}`` — keyword arguments of the algorithm's constructor, each of the
   kind of its default (a number, true/false); the counts of
@@ -45,6 +46,12 @@ A config is a YAML mapping with these keys (the optional ones show their default
   on the training envs and clone it into the policy (and its returns into the value
   function; :mod:`agents.imitation`); 0 starts from a random policy;
 * ``imitation_epochs: 10`` — passes over those steps when cloning;
+* ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
+  keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
+  ``shield_multiple``; its ``gamma`` is ``hyperparameters.gamma``), on a ``DummyVecEnv`` of
+  wrapped envs (Gymnasium ids only, without ``imitation_steps``). PPO, A2C and MaskablePPO
+  then discount by elapsed instants (:mod:`agents.elapsed_discount`); the models are saved with
+  their decision set beside them, so that ``sb3:`` deploys them as transmit/hold policies;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
   batches of a few dozen rows run fastest on one thread; more threads contend with the
   vector env's stepping threads (twice the steps per second with one thread, measured on the
@@ -65,16 +72,23 @@ from typing import Any
 
 import gymnasium as gym
 import yaml
+from sb3_contrib import MaskablePPO
 from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
+from agents.decisions import SelfTriggeredWrapper
 from baselines.cli import require_env_id
 from baselines.policies import require_model_fits
 from etsc_envs.core.files import require_writable_folder
 from etsc_envs.protocol import require_training_seeds
 
-ALGORITHMS: dict[str, type[BaseAlgorithm]] = {"PPO": PPO, "A2C": A2C, "DQN": DQN}
+ALGORITHMS: dict[str, type[BaseAlgorithm]] = {
+    "PPO": PPO,
+    "A2C": A2C,
+    "DQN": DQN,
+    "MaskablePPO": MaskablePPO,
+}
 """Algorithm name in a config → Stable-Baselines3 class."""
 
 TRAINING_ENV_DEFAULTS: dict[str, Any] = {"randomize": True}
@@ -98,6 +112,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "init_from": None,
     "imitation_steps": 0,
     "imitation_epochs": 10,
+    "decisions": None,
 }
 
 CONFIG_SET_ARGUMENTS = ("policy", "env", "seed")
@@ -129,6 +144,7 @@ class TrainConfig:
     init_from: str | None
     imitation_steps: int
     imitation_epochs: int
+    decisions: dict[str, Any] | None
 
     @property
     def algorithm_class(self) -> type[BaseAlgorithm]:
@@ -165,7 +181,8 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         require_training_seeds(seed, n_envs, "config key 'seed'")
     env_id = _check_env_id(values["env_id"])
     env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
-    _check_algorithm_fits_env(algorithm, env_id, env_kwargs)
+    decisions = _check_decisions(values, algorithm, env_id, env_kwargs)
+    _check_algorithm_fits_env(algorithm, env_id, env_kwargs, decisions)
     return TrainConfig(
         env_id=env_id,
         env_kwargs=env_kwargs,
@@ -191,9 +208,10 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         ),
         tensorboard=_check_tensorboard(values["tensorboard"]),
         torch_threads=_check_positive_int("torch_threads", values["torch_threads"]),
-        init_from=_check_init_from(values["init_from"], env_id, env_kwargs),
+        init_from=_check_init_from(values["init_from"], env_id, env_kwargs, decisions),
         imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
+        decisions=decisions,
     )
 
 
@@ -225,9 +243,37 @@ def _check_algorithm(name: Any) -> str:
     return name
 
 
-def _check_algorithm_fits_env(algorithm: str, env_id: str, env_kwargs: dict[str, Any]) -> None:
+def _check_decisions(
+    values: Mapping[str, Any], algorithm: str, env_id: str, env_kwargs: dict[str, Any]
+) -> dict[str, Any] | None:
+    """``values["decisions"]`` if it is null or keywords that build a
+    :class:`~agents.decisions.SelfTriggeredWrapper` for ``env_id``."""
+    if values["decisions"] is None:
+        if algorithm == "MaskablePPO":
+            raise ValueError("config key 'algorithm': MaskablePPO needs the key 'decisions'")
+        return None
+    decisions = _check_mapping("decisions", values["decisions"])
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS or values["imitation_steps"]:
+        raise ValueError(
+            "config key 'decisions' needs a Gymnasium id and no 'imitation_steps', got "
+            f"{env_id} with imitation_steps={values['imitation_steps']!r}"
+        )
+    allowed = ("max_exponent", "factors", "shield_multiple")
+    unknown = sorted(set(decisions) - set(allowed))
+    if unknown:
+        raise ValueError(f"config key 'decisions': {unknown} are not among {list(allowed)}")
+    try:
+        SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), **decisions).close()
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
+    return decisions
+
+
+def _check_algorithm_fits_env(
+    algorithm: str, env_id: str, env_kwargs: dict[str, Any], decisions: dict[str, Any] | None
+) -> None:
     """DQN picks one of finitely many actions: it needs a ``Discrete`` action space."""
-    if algorithm != "DQN":
+    if algorithm != "DQN" or decisions is not None:
         return
     _, action_space = policy_spaces(env_id, env_kwargs)
     if not isinstance(action_space, gym.spaces.Discrete):
@@ -237,10 +283,16 @@ def _check_algorithm_fits_env(algorithm: str, env_id: str, env_kwargs: dict[str,
         )
 
 
-def policy_spaces(env_id: str, env_kwargs: dict[str, Any]) -> tuple[gym.Space, gym.Space]:
+def policy_spaces(
+    env_id: str, env_kwargs: dict[str, Any], decisions: dict[str, Any] | None = None
+) -> tuple[gym.Space, gym.Space]:
     """The observation and action spaces the trained policy acts in (one agent's, for a
-    PettingZoo id), from one env built with ``env_kwargs``."""
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+    PettingZoo id; the decisions' with ``decisions``), from one env built with
+    ``env_kwargs``."""
+    if decisions is not None:
+        env = SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), **decisions)
+        spaces = env.observation_space, env.action_space
+    elif env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env = etsc_envs.make_parallel(env_id, **env_kwargs)
         agent = env.possible_agents[0]
         spaces = env.observation_space(agent), env.action_space(agent)
@@ -391,7 +443,9 @@ def _check_non_negative_int(key: str, value: Any) -> int:
     return value
 
 
-def _check_init_from(value: Any, env_id: str, env_kwargs: dict[str, Any]) -> str | None:
+def _check_init_from(
+    value: Any, env_id: str, env_kwargs: dict[str, Any], decisions: dict[str, Any] | None
+) -> str | None:
     """``value`` if it is null or a saved model that can act in ``env_id``'s spaces."""
     if value is None:
         return None
@@ -401,7 +455,7 @@ def _check_init_from(value: Any, env_id: str, env_kwargs: dict[str, Any]) -> str
             f"got {value!r}"
         )
     try:
-        spaces = policy_spaces(env_id, env_kwargs)
+        spaces = policy_spaces(env_id, env_kwargs, decisions)
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'env_kwargs': {' '.join(str(error).split())}") from None
     require_model_fits(value, *spaces, env_id, "config key 'init_from':")

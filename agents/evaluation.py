@@ -19,6 +19,7 @@ from baselines.batch import run_batch
 from baselines.cli import episode_setup
 from baselines.episodes import to_jsonable
 from baselines.policies import NormalizedModel, normalization_path
+from baselines.self_triggered import DecisionSet, IntervalSchedule, SelfTriggeredPolicy
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.protocol import scenario_set
 
@@ -55,6 +56,9 @@ class PaperComparisonCallback(BaseCallback):
         set_size: validation scenarios per evaluation.
         best_model_path: where the model with the highest mean validation return so far is
             saved (with its observation statistics beside it), or ``None``.
+        decisions: the decision set of a model trained on self-triggered decisions (it is
+            evaluated as :class:`~baselines.self_triggered.SelfTriggeredPolicy` and saved with
+            the set beside it), or ``None``.
 
     Logged (TensorBoard and SB3's logger): ``eval/mean_cost``, ``eval/transmissions``,
     ``eval/return`` and the paper trigger's ``eval/paper_mean_cost``,
@@ -69,6 +73,7 @@ class PaperComparisonCallback(BaseCallback):
         out_path: str | Path,
         set_size: int,
         best_model_path: str | Path | None = None,
+        decisions: DecisionSet | None = None,
     ) -> None:
         super().__init__()
         self.env_id = env_id
@@ -82,10 +87,16 @@ class PaperComparisonCallback(BaseCallback):
         self.paper: dict[str, Any] = {}
         self.best_return = -np.inf
         self._next_evaluation = every
+        self.decisions = decisions
+        self._deployment: tuple[IntervalSchedule, Any, Any] | None = None
 
     def _on_training_start(self) -> None:
         setup = episode_setup(self.env_id, self.env_kwargs)
         paper_trigger = setup.make_policy("paper", {})
+        if self.decisions is not None:
+            spaces = setup.env.observation_space, setup.env.action_space
+            names = setup.env.unwrapped.observation_names
+            self._deployment = (IntervalSchedule(self.decisions, *spaces, names), *spaces)
         setup.env.close()
         self.paper = set_summary(self._run(paper_trigger))
         self._next_evaluation = self.num_timesteps + self.every
@@ -127,6 +138,8 @@ class PaperComparisonCallback(BaseCallback):
         """The current model (and statistics) as the best so far, each file replaced whole."""
         path = self.best_model_path
         path.parent.mkdir(parents=True, exist_ok=True)
+        if self.decisions is not None:
+            self.decisions.save(path)
         temporary = path.with_name(f".{path.stem}.partial.zip")
         self.model.save(temporary)
         temporary.replace(path)
@@ -137,8 +150,14 @@ class PaperComparisonCallback(BaseCallback):
             partial_statistics.replace(normalization_path(path))
 
     def _current_policy(self) -> Any:
-        """The model, reading observations through a frozen copy of the training statistics."""
+        """The model, reading observations through a frozen copy of the training statistics
+        (deployed as a transmit/hold policy when it takes self-triggered decisions)."""
         normalization = self.model.get_vec_normalize_env()
-        if normalization is None:
-            return self.model
-        return NormalizedModel(self.model, pickle.loads(pickle.dumps(normalization)))
+        model = (
+            self.model
+            if normalization is None
+            else NormalizedModel(self.model, pickle.loads(pickle.dumps(normalization)))
+        )
+        if self._deployment is None:
+            return model
+        return SelfTriggeredPolicy(model, *self._deployment)

@@ -47,22 +47,17 @@ from baselines.evaluate import evaluate
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.protocol import DEFAULT_SET_SIZE
-from etsc_envs.triggers.asteroid import PAPER_ALPHA
-from etsc_envs.triggers.attitude_tracking import PAPER_PSI
-from etsc_envs.triggers.inner_formation import default_thresholds
-from etsc_envs.triggers.orbit_attitude import PAPER_GAMMA
+from etsc_envs.triggers import PAPER_THRESHOLDS
 
 SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
 """Multiples of the paper's threshold swept where the threshold is a free positive number."""
 
 
-def _scaled(**paper_values: float) -> list[dict[str, float]]:
-    return [{name: scale * value for name, value in paper_values.items()} for scale in SCALES]
-
-
-def _inner_formation_sweep() -> list[dict[str, float]]:
-    pi1, pi2, pi3 = default_thresholds()
-    return _scaled(pi1=pi1, pi2=pi2, pi3=pi3)
+def _scaled(env_id: str, scales: tuple[float, ...] = SCALES) -> list[dict[str, float]]:
+    """The paper trigger's threshold keywords of ``env_id`` (:data:`PAPER_THRESHOLDS`) at each
+    multiple of ``scales`` of the paper's values."""
+    paper_values = PAPER_THRESHOLDS[env_id]()
+    return [{name: scale * value for name, value in paper_values.items()} for scale in scales]
 
 
 def _cluster_sweep() -> list[dict[str, float]]:
@@ -70,15 +65,14 @@ def _cluster_sweep() -> list[dict[str, float]]:
 
 
 PAPER_SWEEPS = {
-    "etsc/AttitudeTracking-v0": lambda: _scaled(psi=PAPER_PSI),
-    "etsc/OrbitAttitudeTracking-v0": lambda: [
-        {"gamma1": scale * PAPER_GAMMA[0], "gamma2": scale * PAPER_GAMMA[1]}
-        for scale in (0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
-    ],
+    "etsc/AttitudeTracking-v0": lambda: _scaled("etsc/AttitudeTracking-v0"),
+    "etsc/OrbitAttitudeTracking-v0": lambda: _scaled(
+        "etsc/OrbitAttitudeTracking-v0", (0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
+    ),
     "etsc/ClusterContainmentCentral-v0": _cluster_sweep,
     "etsc/ClusterContainment-v0": _cluster_sweep,
-    "etsc/AsteroidOrbitKeeping-v0": lambda: _scaled(alpha=PAPER_ALPHA),
-    "etsc/InnerFormation-v0": _inner_formation_sweep,
+    "etsc/AsteroidOrbitKeeping-v0": lambda: _scaled("etsc/AsteroidOrbitKeeping-v0"),
+    "etsc/InnerFormation-v0": lambda: _scaled("etsc/InnerFormation-v0"),
 }
 """Id → the paper-trigger arguments of each point (the paper's own values among them)."""
 

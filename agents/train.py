@@ -5,7 +5,9 @@
 
 Writes to the output directory ``model.zip`` (a plain SB3 save, loadable by
 ``python -m baselines.evaluate ENV_ID --policy sb3:DIR/model.zip``) with
-``model_vecnormalize.pkl`` beside it when observations are normalised, ``config.yaml`` (the
+``model_vecnormalize.pkl`` beside it when observations are normalised and
+``model_decisions.json`` when it takes self-triggered decisions (config key ``decisions``),
+``config.yaml`` (the
 config after the command-line overrides and defaults), ``train_summary.json`` (wall time,
 timesteps, steps per second and the last episodes' returns and metrics), and as configured
 ``checkpoints/``, ``tensorboard/`` and ``evaluations.json`` (the policy against the paper's
@@ -53,10 +55,17 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, Ve
 
 import etsc_envs
 from agents.config import TrainConfig, load_config
+from agents.decisions import SelfTriggeredWrapper
+from agents.elapsed_discount import (
+    ElapsedRolloutBuffer,
+    ElapsedStepsCallback,
+    MaskableElapsedRolloutBuffer,
+)
 from agents.evaluation import PaperComparisonCallback
 from agents.imitation import imitate_paper_trigger
 from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
 from baselines.policies import ENV_ID_ATTRIBUTE, normalization_path
+from baselines.self_triggered import DecisionSet
 from etsc_envs.core.files import atomic_write_bytes, atomic_write_text
 
 MODEL_FILE = "model.zip"
@@ -81,6 +90,12 @@ RESUMABLE_CHANGES = (
 )
 """Config keys a ``--resume`` may change; any other difference from the checkpoints' config
 refuses the resume (the run would continue another experiment under this config's name)."""
+ELAPSED_BUFFERS = {
+    "PPO": ElapsedRolloutBuffer,
+    "A2C": ElapsedRolloutBuffer,
+    "MaskablePPO": MaskableElapsedRolloutBuffer,
+}
+"""Algorithm → the rollout buffer that discounts self-triggered decisions by elapsed instants."""
 RECENT_EPISODES_KEPT = 5
 """How many of the last finished episodes ``train_summary.json`` reports."""
 
@@ -146,6 +161,7 @@ def _train(
         "env_kwargs", make_training_env, config, checkpoint, exceptions=(TypeError, ValueError)
     )
     model = _build_model(config, env, checkpoint, out_dir)
+    decisions = decision_set(config, env)
     imitation: dict[str, Any] | None = None
     if checkpoint is None:
         if config.checkpoint_every:
@@ -160,7 +176,7 @@ def _train(
             )
     metrics_callback = EpisodeMetricsCallback()
     start = time.perf_counter()
-    periodic = _periodic_callbacks(config, out_dir, env.num_envs, checkpoint)
+    periodic = _periodic_callbacks(config, out_dir, env.num_envs, checkpoint, decisions)
     progress = [ProgressBarCallback()] if _progress_bar_available() else []
     remaining = max(config.total_timesteps - model.num_timesteps, 0)
     steps = whole_rollout_steps(remaining, model)
@@ -170,10 +186,11 @@ def _train(
             f"collects whole rollouts of n_steps x n_envs = {model.n_steps} x {model.n_envs}",
             flush=True,
         )
+    elapsed = [ElapsedStepsCallback()] if _discounts_elapsed_instants(config) else []
     try:
         model.learn(
             total_timesteps=steps,
-            callback=CallbackList([metrics_callback, *periodic, *callbacks, *progress]),
+            callback=CallbackList([*elapsed, metrics_callback, *periodic, *callbacks, *progress]),
             reset_num_timesteps=checkpoint is None,
         )
     finally:
@@ -181,7 +198,7 @@ def _train(
             if hasattr(bar, "pbar"):
                 bar.pbar.close()
     wall_time_s = time.perf_counter() - start
-    save_model(model, out_dir / MODEL_FILE)
+    save_model(model, out_dir / MODEL_FILE, decisions)
     env.close()
     _write_config(config, out_dir / CONFIG_FILE)
     summary = _summary(config, model, metrics_callback, wall_time_s)
@@ -224,6 +241,11 @@ def _build_model(
             seed=config.seed,
             tensorboard_log=tensorboard_log,
             **config.hyperparameters,
+            **(
+                {"rollout_buffer_class": ELAPSED_BUFFERS[config.algorithm]}
+                if _discounts_elapsed_instants(config)
+                else {}
+            ),
         ),
         exceptions=(AssertionError, TypeError, ValueError),
     )
@@ -233,10 +255,32 @@ def _build_model(
     return model
 
 
-def save_model(model: BaseAlgorithm, path: Path) -> None:
-    """Save ``model`` at ``path`` and its normalisation statistics beside it (if any), each
-    through a temporary file and a rename, the statistics first: a model file on disk always
-    has its statistics."""
+def _discounts_elapsed_instants(config: TrainConfig) -> bool:
+    """Whether the run discounts self-triggered decisions by elapsed instants."""
+    return config.decisions is not None and config.algorithm in ELAPSED_BUFFERS
+
+
+def make_decision_env(config: TrainConfig) -> SelfTriggeredWrapper:
+    """One env of ``config.env_id`` taking ``config.decisions``, discounting within an interval
+    by the algorithm's ``gamma``."""
+    return SelfTriggeredWrapper(
+        gym.make(config.env_id, **config.env_kwargs),
+        gamma=config.hyperparameters.get("gamma", 0.99),
+        **config.decisions,
+    )
+
+
+def decision_set(config: TrainConfig, env: VecEnv) -> DecisionSet | None:
+    """The decision set of the training envs (``None`` without ``decisions``)."""
+    return None if config.decisions is None else env.get_attr("decisions", [0])[0]
+
+
+def save_model(model: BaseAlgorithm, path: Path, decisions: DecisionSet | None = None) -> None:
+    """Save ``model`` at ``path`` and its normalisation statistics and decision set beside it
+    (if any), each through a temporary file and a rename, the model last: a model file on disk
+    always has its statistics and decision set."""
+    if decisions is not None:
+        decisions.save(path)
     normalization = model.get_vec_normalize_env()
     if normalization is not None:
         atomic_write_bytes(normalization_path(path), pickle.dumps(normalization))
@@ -246,11 +290,18 @@ def save_model(model: BaseAlgorithm, path: Path) -> None:
 
 
 class AtomicCheckpointCallback(CheckpointCallback):
-    """SB3's checkpoints (``model_<N>_steps.zip`` with ``model_vecnormalize_<N>_steps.pkl``),
-    written through temporary files, statistics first (:func:`save_model`)."""
+    """SB3's checkpoints (``model_<N>_steps.zip`` with ``model_vecnormalize_<N>_steps.pkl``
+    and, for self-triggered decisions, ``model_<N>_steps_decisions.json``), written through
+    temporary files, the model last (:func:`save_model`)."""
+
+    def __init__(self, *args: Any, decisions: DecisionSet | None = None, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.decisions = decisions
 
     def _on_step(self) -> bool:
         if self.n_calls % self.save_freq == 0:
+            if self.decisions is not None:
+                self.decisions.save(self._checkpoint_path(extension="zip"))
             statistics = self.model.get_vec_normalize_env() if self.save_vecnormalize else None
             if statistics is not None:
                 atomic_write_bytes(
@@ -405,7 +456,11 @@ def _previous_evaluations(out_dir: Path, checkpoint: Path) -> list[dict[str, Any
 
 
 def _periodic_callbacks(
-    config: TrainConfig, out_dir: Path, num_envs: int, checkpoint: Path | None
+    config: TrainConfig,
+    out_dir: Path,
+    num_envs: int,
+    checkpoint: Path | None,
+    decisions: DecisionSet | None = None,
 ) -> list[BaseCallback]:
     """Evaluations against the paper trigger and checkpoints, as configured (``num_envs``:
     the training ``VecEnv``'s sub-environments, whose steps the intervals count; a resume from
@@ -420,6 +475,7 @@ def _periodic_callbacks(
             out_dir / EVALUATIONS_FILE,
             config.evaluation_scenarios,
             out_dir / BEST_MODEL_FILE,
+            decisions,
         )
         if checkpoint is not None:
             evaluation.restore(_previous_evaluations(out_dir, checkpoint))
@@ -431,6 +487,7 @@ def _periodic_callbacks(
                 save_path=str(out_dir / CHECKPOINT_DIR),
                 name_prefix=CHECKPOINT_PREFIX,
                 save_vecnormalize=config.normalize_observations or config.normalize_rewards,
+                decisions=decisions,
             )
         )
     return callbacks
@@ -439,12 +496,20 @@ def _periodic_callbacks(
 def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> VecEnv:
     """``config.n_envs`` environments of ``config.env_id`` as one SB3 ``VecEnv`` with episode
     statistics and, as configured, normalisation (restored from ``checkpoint``'s statistics
-    when resuming): the id's native vector env through :class:`SB3VecEnvAdapter` when it has
+    when resuming): with ``decisions``, a ``DummyVecEnv`` of :func:`make_decision_env`; else
+    the id's native vector env through :class:`SB3VecEnvAdapter` when it has
     one (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs; for a PettingZoo id,
     every agent of the shared loops' vector env
     (:class:`~agents.vector_adapter.SharedPolicyVecEnv`)."""
-    if config.env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        env: VecEnv = VecMonitor(
+    if config.decisions is not None:
+        env: VecEnv = make_vec_env(
+            functools.partial(make_decision_env, config),
+            n_envs=config.n_envs,
+            seed=config.seed,
+            vec_env_cls=DummyVecEnv,
+        )
+    elif config.env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env = VecMonitor(
             make_shared_policy_vec_env(config.env_id, config.n_envs, **config.env_kwargs)
         )
         env.seed(config.seed)

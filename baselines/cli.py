@@ -13,10 +13,13 @@ import yaml
 import etsc_envs
 from baselines.episodes import run_episode, run_parallel_episode, to_jsonable
 from baselines.policies import load_sb3
+from baselines.self_triggered import decision_set_path, load_self_triggered
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.triggers import PAPER_TRIGGERS, AlwaysPolicy, PeriodicPolicy
 
 POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
+"""An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
+(:mod:`baselines.self_triggered`)."""
 
 
 def limit_torch_threads() -> None:
@@ -158,8 +161,13 @@ def _policy_for(
     if spec.startswith("sb3:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")
+        path = spec.removeprefix("sb3:")
+        if decision_set_path(path).is_file():
+            return load_self_triggered(
+                path, observation_space, action_space, observation_names(), env_id
+            )
         return load_sb3(
-            spec.removeprefix("sb3:"),
+            path,
             observation_space=observation_space,
             action_space=action_space,
             env_id=env_id,

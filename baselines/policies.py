@@ -8,6 +8,7 @@ deterministic=True) -> (action, state)``.
 
 from __future__ import annotations
 
+import inspect
 import pickle
 import warnings
 import zipfile
@@ -54,8 +55,13 @@ def read_model_record(path: str | Path) -> dict[str, Any]:
     return record
 
 
+MASKABLE_POLICY_MODULE = "sb3_contrib.common.maskable.policies"
+"""The module of the policies of sb3-contrib's ``MaskablePPO`` (what its saves record)."""
+
+
 def infer_sb3_algorithm(path: str | Path) -> type:
-    """The SB3 algorithm class that saved ``path``, read from the zip's ``data`` record.
+    """The SB3 algorithm class that saved ``path``, read from the zip's ``data`` record
+    (sb3-contrib's ``MaskablePPO`` included).
 
     Off-policy algorithms save a policy of their own module (``stable_baselines3.dqn.policies``);
     PPO and A2C share ``stable_baselines3.common.policies`` and differ by PPO's ``clip_range``.
@@ -65,6 +71,10 @@ def infer_sb3_algorithm(path: str | Path) -> type:
     data = read_model_record(path)
     policy_class = data["policy_class"]
     module = getattr(policy_class, "__module__", "")
+    if module == MASKABLE_POLICY_MODULE:
+        from sb3_contrib import MaskablePPO
+
+        return MaskablePPO
     if module == "stable_baselines3.common.policies":
         algorithm_name = "PPO" if "clip_range" in data else "A2C"
     else:
@@ -178,11 +188,26 @@ class NormalizedModel:
         state: Any = None,
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
+        action_masks: np.ndarray | None = None,
     ) -> tuple[np.ndarray, Any]:
+        """The model's ``predict`` on normalised observations (``action_masks`` is passed on
+        when given, for sb3-contrib's ``MaskablePPO``)."""
         normalized = self.normalization.normalize_obs(np.asarray(observation, dtype=np.float32))
+        masks = {} if action_masks is None else {"action_masks": action_masks}
         return self.model.predict(
-            normalized, state=state, episode_start=episode_start, deterministic=deterministic
+            normalized,
+            state=state,
+            episode_start=episode_start,
+            deterministic=deterministic,
+            **masks,
         )
+
+
+def takes_action_masks(model: Any) -> bool:
+    """Whether ``model.predict`` takes ``action_masks`` (sb3-contrib's ``MaskablePPO``, also
+    inside a :class:`NormalizedModel`)."""
+    inner = model.model if isinstance(model, NormalizedModel) else model
+    return "action_masks" in inspect.signature(inner.predict).parameters
 
 
 def load_sb3(

@@ -16,12 +16,18 @@ episode_start=None, deterministic=True) -> (action, state)``::
 
 from __future__ import annotations
 
-from etsc_envs.triggers.asteroid import AsteroidOrbitKeepingTrigger
-from etsc_envs.triggers.attitude_tracking import AttitudeTrackingTrigger
+from collections.abc import Callable
+
+from etsc_envs.triggers.asteroid import PAPER_ALPHA, AsteroidOrbitKeepingTrigger
+from etsc_envs.triggers.attitude_tracking import PAPER_PSI, AttitudeTrackingTrigger
 from etsc_envs.triggers.base import AlwaysPolicy, PeriodicPolicy, TriggerPolicy
-from etsc_envs.triggers.cluster import ClusterContainmentTrigger
-from etsc_envs.triggers.inner_formation import InnerFormationTrigger
-from etsc_envs.triggers.orbit_attitude import OrbitAttitudeTrigger
+from etsc_envs.triggers.cluster import PAPER_C, ClusterContainmentTrigger
+from etsc_envs.triggers.inner_formation import (
+    InnerFormationShield,
+    InnerFormationTrigger,
+    default_thresholds,
+)
+from etsc_envs.triggers.orbit_attitude import PAPER_GAMMA, OrbitAttitudeTrigger
 
 PAPER_TRIGGERS = {
     "etsc/AttitudeTracking-v0": AttitudeTrackingTrigger,
@@ -33,7 +39,30 @@ PAPER_TRIGGERS = {
 }
 """Environment id → the paper's trigger policy class."""
 
+
+def _inner_formation_thresholds() -> dict[str, float]:
+    pi1, pi2, pi3 = default_thresholds()
+    return {"pi1": float(pi1), "pi2": float(pi2), "pi3": float(pi3)}
+
+
+PAPER_THRESHOLDS: dict[str, Callable[[], dict[str, float]]] = {
+    "etsc/AttitudeTracking-v0": lambda: {"psi": PAPER_PSI},
+    "etsc/OrbitAttitudeTracking-v0": lambda: {"gamma1": PAPER_GAMMA[0], "gamma2": PAPER_GAMMA[1]},
+    "etsc/ClusterContainment-v0": lambda: {"c": PAPER_C},
+    "etsc/ClusterContainmentCentral-v0": lambda: {"c": PAPER_C},
+    "etsc/InnerFormation-v0": _inner_formation_thresholds,
+    "etsc/AsteroidOrbitKeeping-v0": lambda: {"alpha": PAPER_ALPHA},
+}
+"""Environment id → the keywords of its paper trigger that set how much error it tolerates
+before transmitting, at the paper's values (a larger value transmits less)."""
+
+PAPER_SHIELDS = {"etsc/InnerFormation-v0": InnerFormationShield}
+"""Environment id → the class of its shield (:class:`InnerFormationShield`'s interface): the
+ids whose papers give a condition under which a hold is unsafe."""
+
 __all__ = [
+    "PAPER_SHIELDS",
+    "PAPER_THRESHOLDS",
     "PAPER_TRIGGERS",
     "AlwaysPolicy",
     "AsteroidOrbitKeepingTrigger",

@@ -15,7 +15,7 @@ import gymnasium as gym
 import numpy as np
 
 
-def _n_bits(action_space: gym.Space) -> int | None:
+def transmit_bits(action_space: gym.Space) -> int | None:
     """Transmit bits per action: ``None`` for Discrete(2), ``n`` for MultiBinary(n)."""
     if isinstance(action_space, gym.spaces.Discrete) and action_space.n == 2:
         return None
@@ -24,7 +24,7 @@ def _n_bits(action_space: gym.Space) -> int | None:
     raise ValueError(f"action_space must be Discrete(2) or MultiBinary(n), got {action_space}")
 
 
-def _batched(obs: np.ndarray, observation_space: gym.Space) -> tuple[np.ndarray, bool]:
+def batched_observations(obs: np.ndarray, observation_space: gym.Space) -> tuple[np.ndarray, bool]:
     """``obs`` with a leading batch axis, and whether the caller gave a single observation."""
     obs = np.asarray(obs)
     single = obs.shape == observation_space.shape
@@ -41,7 +41,7 @@ class TriggerPolicy:
     def __init__(self, observation_space: gym.Space, action_space: gym.Space) -> None:
         self.observation_space = observation_space
         self.action_space = action_space
-        self.n_bits = _n_bits(action_space)
+        self.n_bits = transmit_bits(action_space)
 
     def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
         raise NotImplementedError
@@ -54,7 +54,7 @@ class TriggerPolicy:
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
         """Transmit decision(s) for ``observation`` in the Stable-Baselines3 calling convention."""
-        obs, single = _batched(observation, self.observation_space)
+        obs, single = batched_observations(observation, self.observation_space)
         if episode_start is not None:
             state = self.reset_state(state, np.asarray(episode_start, dtype=bool), len(obs))
         decision, state = self.transmit(obs, state)

@@ -13,6 +13,9 @@ from etsc_envs.triggers.base import TriggerPolicy
 
 AXES = ("x", "y", "z")
 
+PAPER_SHIELD_MULTIPLE = 2.0
+"""How many Π_i the shield of :class:`InnerFormationShield` lets a sampling error reach."""
+
 
 def default_thresholds() -> np.ndarray:
     """Π_i sized by condition (7) for the paper's parameters (equal shares of the bound (A9))."""
@@ -50,3 +53,68 @@ class InnerFormationTrigger(TriggerPolicy):
 
     def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
         return np.abs(obs[:, self.error_indices]) > self.thresholds, state
+
+
+def predicted_sampling_error(velocity_estimate: np.ndarray, hold_s: np.ndarray) -> np.ndarray:
+    """|r_i(t_k + h) - r_i(t_k)| to first order in h after a transmission at t_k: |ψ_i| h.
+
+    Args:
+        velocity_estimate: ψ_i, the observer's velocity estimates, shape ``(batch, 3)`` (m/s).
+        hold_s: hold durations h, shape ``(n,)`` (s).
+
+    Returns the predicted sampling errors, shape ``(batch, n, 3)`` (m).
+    """
+    return np.abs(velocity_estimate)[:, None, :] * np.asarray(hold_s)[None, :, None]
+
+
+class InnerFormationShield:
+    """Which holds keep every axis' sampling error within ``multiple`` × Π_i.
+
+    Theorem 1's bounds (8)-(10) are proved for sampling errors |r_i(t) - r_i(t_k)| ≤ Π_i, which
+    eqs. (4)-(6) enforce, and grow with Π_i (:mod:`etsc_envs.inner_formation.design`): sampling
+    errors kept within m Π_i keep the estimation errors within the bounds of the thresholds
+    m Π_i. A hold of h
+    after a transmission is called unsafe when its first-order sampling error
+    (:func:`predicted_sampling_error`) passes m Π_i on some axis; the paper's own rule with its
+    thresholds scaled by f keeps the error within f Π_i (one sampling period's motion aside), so
+    it is unsafe when f > m. A hold of one sampling period (transmitting at every instant) is
+    always allowed.
+
+    Args:
+        observation_names: the environment's ``observation_names``.
+        sampling_period_s: the environment's sampling period (s).
+        multiple: m > 0.
+        thresholds: Π_i (m); :func:`default_thresholds` when unset.
+    """
+
+    def __init__(
+        self,
+        observation_names: tuple[str, ...],
+        sampling_period_s: float,
+        multiple: float = PAPER_SHIELD_MULTIPLE,
+        thresholds: np.ndarray | None = None,
+    ) -> None:
+        multiple = float(multiple)
+        if not np.isfinite(multiple) or multiple <= 0.0:
+            raise ValueError(f"multiple must be a finite number > 0, got {multiple!r}")
+        if not np.isfinite(sampling_period_s) or sampling_period_s <= 0.0:
+            raise ValueError(f"sampling_period_s must be > 0, got {sampling_period_s!r}")
+        self.multiple = multiple
+        self.sampling_period_s = float(sampling_period_s)
+        self.thresholds = default_thresholds() if thresholds is None else np.asarray(thresholds)
+        self.velocity_indices = [
+            observation_names.index(f"velocity_estimate_mps_{a}") for a in AXES
+        ]
+
+    def allowed_holds(self, obs: np.ndarray, hold_steps: np.ndarray) -> np.ndarray:
+        """Whether each hold of ``hold_steps`` sampling periods is safe after a transmission at
+        the instant of each observation: booleans of shape ``(batch, n)``."""
+        hold_steps = np.asarray(hold_steps)
+        hold_s = hold_steps * self.sampling_period_s
+        error = predicted_sampling_error(obs[:, self.velocity_indices], hold_s)
+        within = (error <= self.multiple * self.thresholds).all(axis=2)
+        return within | (hold_steps == 1)[None, :]
+
+    def allowed_factors(self, factors: np.ndarray) -> np.ndarray:
+        """Whether the paper's rule with its thresholds scaled by each factor is safe."""
+        return np.asarray(factors) <= self.multiple

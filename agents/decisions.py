@@ -1,0 +1,133 @@
+"""Self-triggered decisions as a Gymnasium wrapper over a transmit/hold env, for training.
+
+One step of :class:`SelfTriggeredWrapper` is one decision of :mod:`baselines.self_triggered`:
+hold 2^j instants after transmitting now, or hand the interval to the paper's trigger with its
+threshold scaled by f. The wrapper runs the interval on the unchanged env and returns the
+observation of the next decision instant. Its reward is the interval's rewards discounted
+within it, ``sum_i gamma**i * r_i`` over the ``n`` instants it ran, and ``info["elapsed_steps"]
+= n``, so that an algorithm discounting the next decision by ``gamma**n`` keeps the meaning of
+the per-instant return: Stable-Baselines3 discounts every decision by one constant ``gamma``
+unless it trains with the buffers and callback of :mod:`agents.elapsed_discount` and the same
+``gamma`` as the wrapper's. ``action_masks()`` gives the
+shield's mask for sb3-contrib's ``MaskablePPO``; an unsafe action given anyway is replaced as
+:meth:`~baselines.self_triggered.IntervalSchedule.shielded` says (``info["action"]`` is the one
+run). A model trained here deploys as a transmit/hold policy once its decision set is saved
+beside it (``wrapper.decisions.save(model_path)``).
+"""
+
+from __future__ import annotations
+
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+
+from baselines.self_triggered import (
+    DEFAULT_MAX_EXPONENT,
+    DecisionSet,
+    IntervalSchedule,
+    default_factors,
+)
+
+
+class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Decisions over intervals of a transmit/hold env built by ``gym.make`` (its id names the
+    paper trigger; Gymnasium ids only: the PettingZoo cluster is not wrapped).
+
+    Args:
+        env: the transmit/hold env.
+        max_exponent: the longest hold is 2^max_exponent instants.
+        factors: scalings of the paper's threshold offered as actions (default per id:
+            :func:`~baselines.self_triggered.default_factors`).
+        shield_multiple: the shield's bound, or ``None`` for no shield (ids with a shield:
+            :data:`etsc_envs.triggers.PAPER_SHIELDS`).
+        gamma: the per-instant discount within an interval (in (0, 1]); the algorithm's
+            ``gamma`` when it discounts by elapsed instants.
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        max_exponent: int = DEFAULT_MAX_EXPONENT,
+        factors: tuple[float, ...] | None = None,
+        shield_multiple: float | None = None,
+        gamma: float = 0.99,
+    ) -> None:
+        gym.utils.RecordConstructorArgs.__init__(
+            self,
+            max_exponent=max_exponent,
+            factors=factors,
+            shield_multiple=shield_multiple,
+            gamma=gamma,
+        )
+        gym.Wrapper.__init__(self, env)
+        if env.spec is None:
+            raise ValueError("env must be made by gym.make (its id names the paper trigger)")
+        if not 0.0 < gamma <= 1.0:
+            raise ValueError(f"gamma must be in (0, 1], got {gamma!r}")
+        unwrapped = env.unwrapped
+        self.decisions = DecisionSet(
+            env.spec.id,
+            max_exponent=max_exponent,
+            factors=default_factors(env.spec.id) if factors is None else tuple(factors),
+            shield_multiple=shield_multiple,
+            sampling_period_s=float(unwrapped.params.sampling_period_s),
+        )
+        self.schedule = IntervalSchedule(
+            self.decisions, env.observation_space, env.action_space, unwrapped.observation_names
+        )
+        self.gamma = float(gamma)
+        self.action_space = self.decisions.action_space
+        self._observation: np.ndarray | None = None
+        self._hold_action = np.zeros(env.action_space.shape, dtype=np.int64)
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        observation, info = self.env.reset(seed=seed, options=options)
+        self._observation = observation
+        return observation, info
+
+    def action_masks(self) -> np.ndarray:
+        """The shield's allowed actions at the current decision instant (all without one)."""
+        if self._observation is None:
+            raise gym.error.ResetNeeded("call reset() before action_masks()")
+        return self.schedule.masks(self._observation[None])[0]
+
+    def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        """Run one interval; ``info`` is the last instant's, with ``elapsed_steps``, ``action``
+        (the action run) and ``shielded`` (whether the shield replaced the one given)."""
+        if self._observation is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        given = np.asarray(action).reshape(-1)
+        if given.size != 1 or not self.action_space.contains(np.int64(given[0])):
+            raise ValueError(f"action must be one integer in {self.action_space}, got {action!r}")
+        given = int(given[0])
+        obs = self._observation[None]
+        chosen = self.schedule.shielded(np.array([given]), obs)
+        state = self.schedule.start(chosen)
+        total, steps = 0.0, 0
+        while True:
+            held = int(self.schedule.unconditional_holds(state)[0])
+            actions = [self._hold_action] * held
+            if not held:
+                decision, state = self.schedule.transmit(obs, state)
+                actions = [decision[0].astype(np.int64)]
+            for action_now in actions:
+                observation, reward, terminated, truncated, info = self.env.step(action_now)
+                total += self.gamma**steps * float(reward)
+                steps += 1
+                if terminated or truncated:
+                    break
+            state = state + np.array([0, held])
+            obs = observation[None]
+            if terminated or truncated or self.schedule.interval_over(obs, state)[0]:
+                break
+        self._observation = observation
+        info = {
+            **info,
+            "elapsed_steps": steps,
+            "action": int(chosen[0]),
+            "shielded": bool(chosen[0] != given),
+        }
+        return observation, total, terminated, truncated, info

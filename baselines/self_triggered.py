@@ -1,0 +1,354 @@
+"""Self-triggered decisions: choose, at a decision instant, how the next interval transmits.
+
+An action of :class:`DecisionSet` is one of
+
+* **hold 2^j** (j = 0 .. k): transmit every channel at the decision instant, hold the next
+  2^j - 1 instants; the next decision comes 2^j instants later. Always choosing it is
+  ``periodic every=2^j``.
+* **paper × f**: the paper's trigger with its threshold keywords
+  (:data:`etsc_envs.triggers.PAPER_THRESHOLDS`) scaled by f decides every instant, the
+  decision instant included; the interval ends just before a later instant at which it fires
+  (on any channel), after 2^k instants, or with the episode. Always choosing f = 1 is the
+  paper's trigger.
+
+A multi-channel id (``MultiBinary``: 004, the central cluster) shares one interval: a hold
+sends every channel, the paper's rule sends the channels it names. :class:`IntervalSchedule`
+runs these semantics one instant at a time for a batch of rows; the training wrapper
+(:class:`agents.decisions.SelfTriggeredWrapper`) and the deployed transmit/hold policy
+(:class:`SelfTriggeredPolicy`) both drive it, so they take the same decisions. Where the id has
+a shield (:data:`etsc_envs.triggers.PAPER_SHIELDS`) and a ``shield_multiple`` is set, unsafe
+actions are masked (:meth:`IntervalSchedule.masks`) and an unsafe choice is replaced by the
+longest safe action of its kind below it, or by hold 1, which is always safe.
+
+A model trained on the wrapper is saved with its decision set in ``NAME_decisions.json``
+beside ``NAME.zip`` (:meth:`DecisionSet.save`); ``--policy sb3:NAME.zip`` then loads it through
+:func:`load_self_triggered`.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from baselines.policies import load_sb3, takes_action_masks
+from etsc_envs.core.files import atomic_write_text
+from etsc_envs.triggers import PAPER_SHIELDS, PAPER_THRESHOLDS, PAPER_TRIGGERS
+from etsc_envs.triggers.base import batched_observations, transmit_bits
+
+DEFAULT_MAX_EXPONENT = 10
+"""Longest hold 2^10 = 1024 sampling instants."""
+
+DEFAULT_FACTORS = (0.5, 1.0, 2.0, 4.0)
+"""Scalings of the paper's threshold offered as actions."""
+
+DEFAULT_FACTORS_BY_ID = {
+    # eq. (15) needs 0 < c < 1 (c = 0.6 in the paper): c = 0.15 .. 0.9.
+    "etsc/ClusterContainmentCentral-v0": (0.25, 0.5, 1.0, 1.5),
+    "etsc/ClusterContainment-v0": (0.25, 0.5, 1.0, 1.5),
+}
+"""Ids whose threshold does not admit every factor of :data:`DEFAULT_FACTORS`."""
+
+DECISIONS_SUFFIX = "_decisions.json"
+"""A self-triggered model ``NAME.zip`` keeps its decision set in ``NAME_decisions.json``."""
+
+
+def default_factors(env_id: str) -> tuple[float, ...]:
+    """The threshold factors offered for ``env_id`` by default."""
+    return DEFAULT_FACTORS_BY_ID.get(env_id, DEFAULT_FACTORS)
+
+
+def decision_set_path(model_path: str | Path) -> Path:
+    """Where the decision set of the model saved at ``model_path`` lives."""
+    model_path = Path(model_path)
+    return model_path.with_name(model_path.stem + DECISIONS_SUFFIX)
+
+
+@dataclass(frozen=True)
+class DecisionSet:
+    """The actions of a self-triggered agent (see the module's description).
+
+    Args:
+        env_id: the transmit/hold id the decisions act in.
+        max_exponent: k, the longest hold is 2^k sampling instants (an integer >= 0).
+        factors: the scalings f > 0 of the paper's threshold, one action each.
+        shield_multiple: the shield's bound (for 004, sampling errors within this many Π), or
+            ``None`` for no shield.
+        sampling_period_s: the env's sampling period (s), which the shield converts holds
+            with; needed with ``shield_multiple``.
+    """
+
+    env_id: str
+    max_exponent: int = DEFAULT_MAX_EXPONENT
+    factors: tuple[float, ...] = DEFAULT_FACTORS
+    shield_multiple: float | None = None
+    sampling_period_s: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.env_id not in PAPER_TRIGGERS:
+            raise ValueError(f"env_id: no paper trigger for {self.env_id!r}")
+        exponent = self.max_exponent
+        if isinstance(exponent, bool) or not isinstance(exponent, int) or not 0 <= exponent <= 20:
+            raise ValueError(f"max_exponent must be an integer in 0..20, got {exponent!r}")
+        factors = tuple(float(f) for f in self.factors)
+        if not all(np.isfinite(f) and f > 0.0 for f in factors):
+            raise ValueError(f"factors must be finite numbers > 0, got {self.factors!r}")
+        object.__setattr__(self, "factors", factors)
+        if self.shield_multiple is None:
+            return
+        if self.env_id not in PAPER_SHIELDS:
+            raise ValueError(
+                f"shield_multiple: no shield for {self.env_id}; shields exist for "
+                f"{sorted(PAPER_SHIELDS)}"
+            )
+        if self.sampling_period_s is None:
+            raise ValueError("sampling_period_s must be given with shield_multiple")
+
+    @property
+    def hold_steps(self) -> np.ndarray:
+        """Sampling instants of each hold action: 1, 2, 4, ..., 2^k."""
+        return 2 ** np.arange(self.max_exponent + 1)
+
+    @property
+    def n_holds(self) -> int:
+        return self.max_exponent + 1
+
+    @property
+    def action_space(self) -> gym.spaces.Discrete:
+        """Holds first (ascending), then the factors (in the given order)."""
+        return gym.spaces.Discrete(self.n_holds + len(self.factors))
+
+    def label(self, action: int) -> str:
+        """``action`` in words (``hold 8``, ``paper x2``)."""
+        if action < self.n_holds:
+            return f"hold {int(self.hold_steps[action])}"
+        return f"paper x{self.factors[action - self.n_holds]:g}"
+
+    def save(self, model_path: str | Path) -> Path:
+        """Write the set beside the model saved at ``model_path`` (:func:`decision_set_path`)."""
+        path = decision_set_path(model_path)
+        atomic_write_text(path, json.dumps(asdict(self), indent=2) + "\n")
+        return path
+
+    @classmethod
+    def load(cls, model_path: str | Path) -> DecisionSet:
+        """The set saved beside ``model_path``; ``ValueError`` naming the file if unreadable."""
+        path = decision_set_path(model_path)
+        try:
+            record = json.loads(path.read_text())
+            record["factors"] = tuple(record["factors"])
+            return cls(**record)
+        except (OSError, ValueError, TypeError, KeyError) as error:
+            raise ValueError(f"decision set {path} is not readable ({error})") from None
+
+
+def scaled_paper_trigger(
+    env_id: str,
+    factor: float,
+    observation_space: gym.Space,
+    action_space: gym.Space,
+    observation_names: tuple[str, ...],
+) -> Any:
+    """The paper trigger of ``env_id`` with its threshold keywords
+    (:data:`~etsc_envs.triggers.PAPER_THRESHOLDS`) scaled by ``factor``; ``ValueError`` naming
+    ``factors`` when the scaled values leave the trigger's range."""
+    thresholds = PAPER_THRESHOLDS[env_id]()
+    scaled = {name: factor * value for name, value in thresholds.items()}
+    try:
+        return PAPER_TRIGGERS[env_id](observation_space, action_space, observation_names, **scaled)
+    except ValueError as error:
+        raise ValueError(f"factors: {factor:g} x the paper's threshold: {error}") from None
+
+
+class IntervalSchedule:
+    """The per-instant semantics of a :class:`DecisionSet` for a batch of rows.
+
+    A row's state is ``(action, elapsed)``: the interval's action and the instants it has run.
+
+    Args:
+        decisions: the decision set.
+        observation_space, action_space: the transmit/hold env's spaces.
+        observation_names: its ``observation_names``.
+    """
+
+    def __init__(
+        self,
+        decisions: DecisionSet,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        observation_names: tuple[str, ...],
+    ) -> None:
+        self.decisions = decisions
+        self.n_bits = transmit_bits(action_space)
+        self.triggers = [
+            scaled_paper_trigger(
+                decisions.env_id, factor, observation_space, action_space, observation_names
+            )
+            for factor in decisions.factors
+        ]
+        self.shield = (
+            None
+            if decisions.shield_multiple is None
+            else PAPER_SHIELDS[decisions.env_id](
+                observation_names, decisions.sampling_period_s, decisions.shield_multiple
+            )
+        )
+
+    def masks(self, obs: np.ndarray) -> np.ndarray:
+        """Allowed actions at decision instants with observations ``obs``: ``(batch, n)``."""
+        decisions = self.decisions
+        if self.shield is None:
+            return np.ones((len(obs), decisions.action_space.n), dtype=bool)
+        holds = self.shield.allowed_holds(obs, decisions.hold_steps)
+        factors = np.broadcast_to(
+            self.shield.allowed_factors(np.array(decisions.factors)),
+            (len(obs), len(decisions.factors)),
+        )
+        return np.concatenate([holds, factors], axis=1)
+
+    def shielded(self, actions: np.ndarray, obs: np.ndarray) -> np.ndarray:
+        """``actions`` with each unsafe one replaced by the longest safe action of its kind
+        below it, or by hold 1 (action 0) where there is none."""
+        actions = np.asarray(actions, dtype=np.int64).reshape(-1)
+        if self.shield is None:
+            return actions
+        allowed = self.masks(obs)
+        n_holds = self.decisions.n_holds
+        replaced = actions.copy()
+        for row in np.flatnonzero(~allowed[np.arange(len(actions)), actions]):
+            first = 0 if actions[row] < n_holds else n_holds
+            safe = np.flatnonzero(allowed[row, first : actions[row]])
+            replaced[row] = first + safe[-1] if len(safe) else 0
+        return replaced
+
+    def start(self, actions: np.ndarray) -> np.ndarray:
+        """The state of rows starting an interval with ``actions``."""
+        actions = np.asarray(actions, dtype=np.int64).reshape(-1)
+        return np.stack([actions, np.zeros_like(actions)], axis=1)
+
+    def _rule_fires(self, obs: np.ndarray, state: np.ndarray) -> np.ndarray:
+        """The scaled paper triggers' decisions on the rows following one; other rows False."""
+        shape = (len(obs),) if self.n_bits is None else (len(obs), self.n_bits)
+        fires = np.zeros(shape, dtype=bool)
+        for index, trigger in enumerate(self.triggers):
+            rows = state[:, 0] == self.decisions.n_holds + index
+            if rows.any():
+                fires[rows] = trigger.transmit(obs[rows], None)[0]
+        return fires
+
+    def interval_over(self, obs: np.ndarray, state: np.ndarray) -> np.ndarray:
+        """Whether each row's interval has ended before the instant of ``obs``."""
+        decisions = self.decisions
+        action, elapsed = state[:, 0], state[:, 1]
+        holding = action < decisions.n_holds
+        hold_length = decisions.hold_steps[np.minimum(action, decisions.n_holds - 1)]
+        fires = self._rule_fires(obs, state)
+        if fires.ndim == 2:
+            fires = fires.any(axis=1)
+        rule_over = (elapsed >= decisions.hold_steps[-1]) | ((elapsed >= 1) & fires)
+        return np.where(holding, elapsed >= hold_length, rule_over)
+
+    def unconditional_holds(self, state: np.ndarray) -> np.ndarray:
+        """Per row, the instants from the current one on that hold whatever is observed: the
+        rest of a hold interval after its transmission; 0 elsewhere."""
+        action, elapsed = state[:, 0], state[:, 1]
+        holding = (action < self.decisions.n_holds) & (elapsed >= 1)
+        length = self.decisions.hold_steps[np.minimum(action, self.decisions.n_holds - 1)]
+        return np.where(holding, length - elapsed, 0)
+
+    def transmit(self, obs: np.ndarray, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each row's transmit decision at the instant of ``obs`` (booleans, one column per
+        channel for ``MultiBinary``) and the state after it."""
+        first = (state[:, 0] < self.decisions.n_holds) & (state[:, 1] == 0)
+        decision = self._rule_fires(obs, state)
+        decision[first] = True
+        return decision, state + np.array([0, 1])
+
+
+class SelfTriggeredPolicy:
+    """A model trained on self-triggered decisions, deployed as a transmit/hold policy.
+
+    ``predict`` follows Stable-Baselines3's convention; its recurrent ``state`` holds each
+    row's ``(action, elapsed)`` (:class:`IntervalSchedule`). At a row's decision instant (its
+    episode start, or its interval's end) the model picks the next action, masked by the
+    shield if the set has one (``action_masks`` is passed to a model that takes it, such as
+    ``MaskablePPO``; any other model's unsafe choice is replaced).
+
+    Args:
+        model: anything with an SB3-style ``predict`` over the decision set's actions.
+        schedule: the decision set's schedule for the transmit/hold env.
+        observation_space, action_space: the transmit/hold env's spaces.
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        schedule: IntervalSchedule,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+    ) -> None:
+        self.model = model
+        self.schedule = schedule
+        self.observation_space = observation_space
+        self.action_space = action_space
+
+    def choose(self, obs: np.ndarray, deterministic: bool = True) -> np.ndarray:
+        """The model's (shielded) actions at decision instants with observations ``obs``."""
+        if self.schedule.shield is not None and takes_action_masks(self.model):
+            masks = self.schedule.masks(obs)
+            actions, _ = self.model.predict(obs, deterministic=deterministic, action_masks=masks)
+        else:
+            actions, _ = self.model.predict(obs, deterministic=deterministic)
+        return self.schedule.shielded(actions, obs)
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: np.ndarray | None = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Transmit decision(s) for ``observation``, and the rows' interval state."""
+        obs, single = batched_observations(observation, self.observation_space)
+        if state is None:
+            state, deciding = self.schedule.start(np.zeros(len(obs))), np.ones(len(obs), bool)
+        else:
+            state = np.array(state, dtype=np.int64)
+            deciding = self.schedule.interval_over(obs, state)
+        if episode_start is not None:
+            deciding |= np.asarray(episode_start, dtype=bool).reshape(-1)
+        if deciding.any():
+            state[deciding] = self.schedule.start(self.choose(obs[deciding], deterministic))
+        decision, state = self.schedule.transmit(obs, state)
+        action = decision.astype(np.int64)
+        return (action[0] if single else action), state
+
+
+def load_self_triggered(
+    path: str | Path,
+    observation_space: gym.Space,
+    action_space: gym.Space,
+    observation_names: tuple[str, ...],
+    env_id: str,
+) -> SelfTriggeredPolicy:
+    """The model saved at ``path`` with its decision set beside it, deployed as a transmit/hold
+    policy for ``env_id``; ``ValueError`` if the set was made for another id or the model does
+    not fit its observations and actions."""
+    decisions = DecisionSet.load(path)
+    if decisions.env_id != env_id:
+        raise ValueError(
+            f"sb3 model {path} takes self-triggered decisions in {decisions.env_id}, "
+            f"not in {env_id}"
+        )
+    model = load_sb3(
+        path,
+        observation_space=observation_space,
+        action_space=decisions.action_space,
+        env_id=f"{env_id} (self-triggered, {decisions.action_space.n} actions)",
+    )
+    schedule = IntervalSchedule(decisions, observation_space, action_space, observation_names)
+    return SelfTriggeredPolicy(model, schedule, observation_space, action_space)

@@ -1,0 +1,272 @@
+"""Self-triggered decisions: the training wrapper, its deployed transmit/hold policy, the
+shield, and a short training run that reloads through ``sb3:`` (short horizons)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import etsc_envs  # noqa: F401  (registers the ids)
+from agents.decisions import SelfTriggeredWrapper
+from baselines.cli import make_policy
+from baselines.episodes import run_episode
+from baselines.evaluate import evaluate
+from baselines.policies import load_sb3, takes_action_masks
+from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
+from etsc_envs.triggers import PAPER_TRIGGERS, PeriodicPolicy
+from etsc_envs.triggers.inner_formation import InnerFormationShield
+
+ATTITUDE = "etsc/AttitudeTracking-v0"
+FORMATION = "etsc/InnerFormation-v0"
+HORIZON_S = 0.4
+SEED = 3
+
+
+class RecordedActions(gym.Wrapper):
+    """Keeps every transmit/hold action the env is stepped with."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self.actions: list[np.ndarray] = []
+
+    def step(self, action):
+        self.actions.append(np.asarray(action).copy())
+        return self.env.step(action)
+
+
+class ScriptedModel:
+    """A stand-in for a trained model: an action that varies with the observation."""
+
+    def __init__(self, n_actions: int, fixed: int | None = None) -> None:
+        self.n_actions = n_actions
+        self.fixed = fixed
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        obs = np.asarray(observation)
+        if self.fixed is not None:
+            return np.full(len(obs), self.fixed), None
+        digits = np.abs(obs).sum(axis=1) * 1e4
+        return (digits.astype(np.int64) % self.n_actions), None
+
+
+def recorded(env_id: str) -> RecordedActions:
+    return RecordedActions(gym.make(env_id, horizon_s=HORIZON_S))
+
+
+def wrapper_actions(env_id: str, model, **kwargs) -> tuple[list[np.ndarray], list[dict]]:
+    """Transmit/hold actions of one seeded episode of the wrapper driven by ``model``, and the
+    infos of its decisions."""
+    base = recorded(env_id)
+    wrapper = SelfTriggeredWrapper(base, **kwargs)
+    obs, _ = wrapper.reset(seed=SEED)
+    infos, done = [], False
+    while not done:
+        action, _ = model.predict(obs[None])
+        obs, _, terminated, truncated, info = wrapper.step(action[0])
+        infos.append(info)
+        done = terminated or truncated
+    return base.actions, infos
+
+
+def policy_actions(env_id: str, policy) -> list[np.ndarray]:
+    """Transmit/hold actions of one seeded episode of ``policy`` on the plain env."""
+    base = recorded(env_id)
+    run_episode(base, policy, SEED)
+    return base.actions
+
+
+def paper_policy(env_id: str):
+    env = gym.make(env_id, horizon_s=HORIZON_S)
+    unwrapped = env.unwrapped
+    return PAPER_TRIGGERS[env_id](
+        env.observation_space, env.action_space, unwrapped.observation_names
+    )
+
+
+def deployed(env_id: str, model, **kwargs) -> SelfTriggeredPolicy:
+    wrapper = SelfTriggeredWrapper(gym.make(env_id, horizon_s=HORIZON_S), **kwargs)
+    env = wrapper.env
+    return SelfTriggeredPolicy(model, wrapper.schedule, env.observation_space, env.action_space)
+
+
+def assert_same(first: list[np.ndarray], second: list[np.ndarray]) -> None:
+    assert len(first) == len(second)
+    np.testing.assert_array_equal(np.array(first), np.array(second))
+
+
+@pytest.mark.parametrize("env_id", [ATTITUDE, FORMATION])
+def test_follow_the_paper_is_the_paper_trigger(env_id):
+    decisions = DecisionSet(env_id, max_exponent=3)
+    follow = decisions.n_holds + decisions.factors.index(1.0)
+    actions, _ = wrapper_actions(env_id, ScriptedModel(0, fixed=follow), max_exponent=3)
+    paper = policy_actions(env_id, paper_policy(env_id))
+    assert np.array(paper).any()
+    assert_same(actions, paper)
+
+
+def test_hold_is_the_clock():
+    env = gym.make(ATTITUDE, horizon_s=HORIZON_S)
+    clock = PeriodicPolicy(env.observation_space, env.action_space, every=8)
+    actions, infos = wrapper_actions(ATTITUDE, ScriptedModel(0, fixed=3), max_exponent=3)
+    assert_same(actions, policy_actions(ATTITUDE, clock))
+    assert {info["elapsed_steps"] for info in infos[:-1]} == {8}
+
+
+@pytest.mark.parametrize(("env_id", "shield"), [(ATTITUDE, None), (FORMATION, 0.5)])
+def test_deployed_policy_takes_the_training_decisions(env_id, shield):
+    kwargs = {"max_exponent": 4, "shield_multiple": shield}
+    model = ScriptedModel(DecisionSet(env_id, max_exponent=4).action_space.n)
+    actions, infos = wrapper_actions(env_id, model, **kwargs)
+    assert len({info["action"] for info in infos}) > 3
+    assert_same(actions, policy_actions(env_id, deployed(env_id, model, **kwargs)))
+
+
+def test_shield_lets_no_forbidden_hold_through():
+    kwargs = {"max_exponent": 10, "shield_multiple": 0.5}
+    n_actions = DecisionSet(FORMATION, max_exponent=10).action_space.n
+    base = recorded(FORMATION)
+    wrapper = SelfTriggeredWrapper(base, **kwargs)
+    wrapper.reset(seed=SEED)
+    longest_hold, largest_factor = 10, n_actions - 1
+    replaced, decisions, done = 0, 0, False
+    while not done:
+        mask = wrapper.action_masks()
+        assert mask[0]
+        given = (largest_factor, longest_hold)[decisions % 2]
+        decisions += 1
+        _, _, terminated, truncated, info = wrapper.step(given)
+        assert mask[info["action"]]
+        replaced += info["shielded"]
+        done = terminated or truncated
+    assert replaced > 0
+
+
+def test_shield_forbids_holds_that_outrun_the_threshold():
+    env = gym.make(FORMATION)
+    names = env.unwrapped.observation_names
+    shield = InnerFormationShield(names, 0.001, multiple=2.0, thresholds=np.full(3, 0.01))
+    obs = np.zeros((2, len(names)))
+    obs[1, names.index("velocity_estimate_mps_y")] = 1.0  # 1 m/s: 2 Π = 0.02 m in 20 ms
+    allowed = shield.allowed_holds(obs, np.array([1, 16, 32]))
+    np.testing.assert_array_equal(allowed, [[True, True, True], [True, True, False]])
+    np.testing.assert_array_equal(shield.allowed_factors(np.array([1.0, 2.0, 4.0])), [1, 1, 0])
+
+
+def test_wrapper_passes_gymnasium_check_env():
+    env = SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.05), max_exponent=3)
+    check_env(env, skip_render_check=True)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "argument"),
+    [
+        ({"factors": (1.0, -2.0)}, "factors"),
+        ({"max_exponent": -1}, "max_exponent"),
+        ({"gamma": 0.0}, "gamma"),
+    ],
+)
+def test_bad_arguments_name_themselves(kwargs, argument):
+    with pytest.raises(ValueError, match=argument):
+        SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.05), **kwargs)
+
+
+def test_factors_outside_the_trigger_range_name_themselves():
+    env = gym.make("etsc/ClusterContainmentCentral-v0", horizon_s=0.05)
+    with pytest.raises(ValueError, match="factors: 2 x"):
+        SelfTriggeredWrapper(env, factors=(1.0, 2.0))
+
+
+def test_an_unreadable_decision_set_names_its_file(tmp_path):
+    (tmp_path / "model_decisions.json").write_text("{not json")
+    with pytest.raises(ValueError, match=r"model_decisions\.json"):
+        DecisionSet.load(tmp_path / "model.zip")
+
+
+def test_shield_only_where_the_paper_gives_one():
+    with pytest.raises(ValueError, match="shield_multiple"):
+        DecisionSet(ATTITUDE, shield_multiple=2.0)
+
+
+@pytest.mark.parametrize("algorithm", ["MaskablePPO", "PPO"])
+def test_short_training_saves_reloads_and_evaluates(tmp_path, algorithm):
+    import sb3_contrib
+    import stable_baselines3
+
+    kwargs = {"max_exponent": 3, "shield_multiple": 2.0}
+    wrapper = SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.1), **kwargs)
+    module = sb3_contrib if algorithm == "MaskablePPO" else stable_baselines3
+    model = getattr(module, algorithm)(
+        "MlpPolicy", wrapper, n_steps=32, batch_size=32, n_epochs=1, device="cpu", seed=0
+    )
+    model.learn(total_timesteps=64)
+    path = tmp_path / "model.zip"
+    model.save(path)
+    wrapper.decisions.save(path)
+
+    env = gym.make(FORMATION, horizon_s=0.1)
+    policy = make_policy(f"sb3:{path}", env, {}, FORMATION)
+    assert isinstance(policy, SelfTriggeredPolicy)
+    assert takes_action_masks(policy.model) == (algorithm == "MaskablePPO")
+    env_args = {"horizon_s": 0.1}
+    batch = evaluate(FORMATION, f"sb3:{path}", env_args=env_args, episodes=2, seed=SEED)
+    for record in batch["episodes"]:
+        single = evaluate(FORMATION, f"sb3:{path}", env_args=env_args, seed=record["seed"])
+        assert record["transmissions"] == single["episodes"][0]["transmissions"] > 0
+        assert record["mean_cost"] == pytest.approx(single["episodes"][0]["mean_cost"])
+
+
+def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
+    import yaml
+
+    from agents.train import main
+
+    out_dir = tmp_path / "run"
+    config = {
+        "env_id": FORMATION,
+        "env_kwargs": {"horizon_s": 0.1},
+        "algorithm": "MaskablePPO",
+        "policy": "MlpPolicy",
+        "hyperparameters": {"n_steps": 32, "batch_size": 32, "n_epochs": 1, "gamma": 0.999},
+        "total_timesteps": 64,
+        "out_dir": str(out_dir),
+        "decisions": {"max_exponent": 3, "shield_multiple": 2.0},
+        "evaluation_every": 32,
+        "evaluation_scenarios": 2,
+        "evaluation_env_kwargs": {"horizon_s": 0.1},
+        "checkpoint_every": 32,
+        "tensorboard": False,
+    }
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    assert main(["--config", str(path)]) == 0
+    for name in ("model", "best_model", "checkpoints/model_32_steps"):
+        assert DecisionSet.load(out_dir / f"{name}.zip").shield_multiple == 2.0
+    assert takes_action_masks(load_sb3(out_dir / "model.zip"))  # normalised MaskablePPO
+    result = evaluate(FORMATION, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
+    assert result["episodes"][0]["transmissions"] > 0
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"algorithm": "MaskablePPO"}, "MaskablePPO needs the key 'decisions'"),
+        ({"decisions": {"max_exponent": 3, "holds": 2}}, "'decisions'"),
+        ({"decisions": {"shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
+        ({"decisions": {}, "imitation_steps": 64}, "imitation_steps"),
+    ],
+)
+def test_training_config_checks_the_decisions(tmp_path, changes, message):
+    from agents.config import config_from_dict
+
+    config = {
+        "env_id": FORMATION,
+        "env_kwargs": {"horizon_s": 0.1},
+        "algorithm": "PPO",
+        "policy": "MlpPolicy",
+        "total_timesteps": 64,
+        "out_dir": str(tmp_path / "run"),
+    }
+    with pytest.raises(ValueError, match=message):
+        config_from_dict({**config, **changes})
