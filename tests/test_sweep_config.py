@@ -191,7 +191,8 @@ def test_without_ray_the_sweep_command_says_which_extra_to_install() -> None:
 def test_model_paths_are_made_absolute_for_trials_that_run_elsewhere(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    (tmp_path / "stage1.zip").write_bytes(b"")
+    model = ROOT / "models" / "AttitudeTracking-v0_ppo.zip"
+    (tmp_path / "stage1.zip").write_bytes(model.read_bytes())
     monkeypatch.chdir(tmp_path)
     grid = {"init_from": ["stage1.zip"], "seed": [1]}
     config = sweep_config_from_dict(sweep(tmp_path, grid=grid, results_dir="out"))
