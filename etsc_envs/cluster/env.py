@@ -81,6 +81,12 @@ the adaptive gains of eqs. (20)-(21) grow without a stated limit, and e_J with t
 PERIODIC_TERMS = 4
 RANDOM_ATTITUDE_MAX_NORM = 0.6
 RANDOM_RATE_MAX_RAD_S = 0.015
+SETTLED_HULL_DISTANCE = 0.01
+"""``settled`` (the protocol's criterion, not the paper's): every follower's rate has
+converged (``omega_converge_time_s`` exists) and every follower ends within this MRP distance
+of the leaders' convex hull. The sliding-mode boundary layer leaves a follower an offset of
+about s/(α·in-degree) outside it (docs/fidelity.md, reading 2); on the paper scenario and on
+the test draws the final distance stays below 0.007."""
 
 
 def cluster_model(params: ClusterContainmentParams, disturbance_phase: np.ndarray) -> ClusterModel:
@@ -291,9 +297,16 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
         }
 
     def _settled_at_end(self, metrics: dict[str, Any]) -> bool:
-        """Every follower entered its containment neighbourhood and stayed (the paper's
-        convergence statement, ``converge_time_s`` exists)."""
-        return metrics["converge_time_s"] is not None
+        """Rates converged and every follower within :data:`SETTLED_HULL_DISTANCE` of the hull.
+
+        ``converge_time_s`` (entry within 5 % of the initial hull distance) is too strict a
+        test of settling for random starts: a follower that starts near the hull has a
+        threshold below the boundary layer's offset and never meets it, though it ends as
+        close to the hull as the others."""
+        return (
+            metrics["omega_converge_time_s"] is not None
+            and metrics["final_hull_distance"] <= SETTLED_HULL_DISTANCE
+        )
 
     def _omega_converge_time(self) -> float | None:
         """First time after which every ‖ω_i‖ stays below 5 % of the episode's peak."""
