@@ -128,7 +128,11 @@ def test_every_shipped_config_trains_saves_reloads_and_evaluates(
     from baselines.policies import NormalizedModel, load_sb3, normalization_path
 
     out_dir = tmp_path / "run"
-    config = tiny_config(out_dir, config_path) | {"n_envs": 2, "evaluation_every": 128}
+    config = tiny_config(out_dir, config_path) | {
+        "n_envs": 2,
+        "evaluation_every": 128,
+        "evaluation_scenarios": 2,
+    }
     assert main(["--config", str(write_config(config, tmp_path))]) == 0
 
     model_path = out_dir / MODEL_FILE
