@@ -265,11 +265,11 @@ def compare(
 
 
 def seed_groups(trials: list[Any]) -> dict[str, list[str]]:
-    """Sweep trials grouped by their swept values other than ``seed`` (one method each):
-    group name → the models of its trials."""
+    """Sweep trials grouped by their name without its ``seed=`` part (one method each, the
+    trials' other swept values): group name → the models of its trials."""
     groups: dict[str, list[str]] = {}
     for trial in trials:
-        kept = [f"{key}={value}" for key, value in sorted(trial.values.items()) if key != "seed"]
+        kept = [part for part in trial.name.split(",") if not part.startswith("seed=")]
         groups.setdefault(",".join(kept) or "all", []).append(str(trial.model))
     return groups
 
