@@ -66,7 +66,7 @@ import dataclasses
 import importlib
 import importlib.util
 import inspect
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -215,14 +215,22 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     )
 
 
-def _check_key_set(raw: Mapping[str, Any]) -> None:
-    allowed = (*REQUIRED_KEYS, *OPTIONAL_DEFAULTS)
+def require_key_set(
+    raw: Mapping[str, Any], required: tuple[str, ...], optional: Iterable[str], kind: str
+) -> None:
+    """``ValueError`` naming the unknown and the missing keys of a ``kind`` mapping (a training
+    config, a sweep)."""
+    allowed = (*required, *optional)
     unknown = sorted(str(key) for key in raw if key not in allowed)
     if unknown:
-        raise ValueError(f"unknown config key(s) {unknown}; allowed keys: {list(allowed)}")
-    missing = [key for key in REQUIRED_KEYS if key not in raw]
+        raise ValueError(f"unknown {kind} key(s) {unknown}; allowed keys: {list(allowed)}")
+    missing = [key for key in required if key not in raw]
     if missing:
-        raise ValueError(f"missing config key(s) {missing}; required keys: {list(REQUIRED_KEYS)}")
+        raise ValueError(f"missing {kind} key(s) {missing}; required keys: {list(required)}")
+
+
+def _check_key_set(raw: Mapping[str, Any]) -> None:
+    require_key_set(raw, REQUIRED_KEYS, OPTIONAL_DEFAULTS, "config")
 
 
 def _check_env_id(env_id: Any) -> str:

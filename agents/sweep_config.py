@@ -53,7 +53,13 @@ from typing import Any
 
 import yaml
 
-from agents.config import OPTIONAL_DEFAULTS, REQUIRED_KEYS, TrainConfig, config_from_dict
+from agents.config import (
+    OPTIONAL_DEFAULTS,
+    REQUIRED_KEYS,
+    TrainConfig,
+    config_from_dict,
+    require_key_set,
+)
 from agents.sweep_results import EVALUATION_METRICS, METRICS, TRIALS_DIR
 
 KINDS = ("front", "search")
@@ -256,15 +262,7 @@ def _assign(raw: dict[str, Any], key: str, value: Any) -> None:
 
 
 def _check_key_set(raw: Mapping[str, Any]) -> None:
-    allowed = (*REQUIRED_SWEEP_KEYS, *OPTIONAL_SWEEP_DEFAULTS)
-    unknown = sorted(str(key) for key in raw if key not in allowed)
-    if unknown:
-        raise ValueError(f"unknown sweep key(s) {unknown}; allowed keys: {list(allowed)}")
-    missing = [key for key in REQUIRED_SWEEP_KEYS if key not in raw]
-    if missing:
-        raise ValueError(
-            f"missing sweep key(s) {missing}; required keys: {list(REQUIRED_SWEEP_KEYS)}"
-        )
+    require_key_set(raw, REQUIRED_SWEEP_KEYS, OPTIONAL_SWEEP_DEFAULTS, "sweep")
 
 
 def _check_training_key(section: str, key: Any) -> str:
