@@ -126,7 +126,7 @@ def test_resuming_runs_the_rest_and_not_the_finished_trial(interrupted_sweep) ->
     assert summary["counts"] == {"finished": 2, "failed": 1, "incomplete": 0}
     resumed = interrupted_sweep["resumed"]
     assert resumed.returncode == 1, "a failed trial makes the sweep exit with 1"
-    assert f"failed     {CRASHING}  ValueError: transmission_penalty" in resumed.stdout
+    assert f"failed     {CRASHING}  ValueError: config key 'env_kwargs'" in resumed.stdout
 
 
 def test_both_trials_leave_a_model_its_statistics_and_evaluations(interrupted_sweep) -> None:
