@@ -24,7 +24,8 @@ with failures crossed, and the paper scenario in a second panel.
 
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
 ``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper and periodic curves of
-an earlier run (same id, kwargs and scenario set) and runs only the models.
+an earlier run (same closed loop, kwargs and scenario set: the PettingZoo cluster may reuse
+its central form's) and runs only the models.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ import gymnasium as gym
 import matplotlib.pyplot as plt
 from matplotlib import ticker
 
-import etsc_envs  # noqa: F401  (registers the ids)
+import etsc_envs
 from agents.evaluation import episode_summary
 from agents.sweep_results import sweep_models
 from baselines.cli import limit_torch_threads, parse_assignments, require_policies, write_json
@@ -128,6 +129,13 @@ def run_point(
     }
 
 
+def closed_loop_id(env_id: str) -> str:
+    """The Gymnasium id of the closed loop ``env_id`` runs: a PettingZoo id's agents share the
+    loop of its central form, so the paper and periodic points of the two ids are the same
+    episodes (the agents' bits are the central form's action) and one's curves serve both."""
+    return etsc_envs.PETTINGZOO_LOOP_IDS.get(env_id, env_id)
+
+
 def pareto(
     env_id: str,
     models: list[str],
@@ -143,12 +151,15 @@ def pareto(
         raise ValueError(f"no Pareto sweep for {env_id}; known: {sorted(PAPER_SWEEPS)}")
     if scenarios not in ("test", "validation"):
         raise ValueError(f"--scenarios must be 'test' or 'validation', got {scenarios!r}")
-    identity = (env_id, env_kwargs, scenarios, set_size)
+    identity = (closed_loop_id(env_id), env_kwargs, scenarios, set_size)
     if reuse is not None:
-        earlier = tuple(reuse.get(key) for key in ("env", "env_kwargs", "scenarios", "set_size"))
+        earlier = (
+            closed_loop_id(str(reuse.get("env"))),
+            *(reuse.get(key) for key in ("env_kwargs", "scenarios", "set_size")),
+        )
         if earlier != identity:
             raise ValueError(
-                f"--reuse: that result is of (env, env_kwargs, scenarios, set_size) = "
+                f"--reuse: that result is of (closed loop, env_kwargs, scenarios, set_size) = "
                 f"{earlier}, not {identity}"
             )
 

@@ -70,3 +70,21 @@ def test_reuse_keeps_the_earlier_curves_and_checks_they_match(tmp_path: Path) ->
     assert again["curves"] == earlier["curves"]
     with pytest.raises(SystemExit):
         main(["etsc/AttitudeTracking-v0", "--reuse", str(first / "pareto.json")])
+
+
+def test_the_pettingzoo_cluster_shares_its_central_forms_baseline_points(tmp_path: Path) -> None:
+    argv = ["--env-arg", "horizon_s=0.05", "--set-size", "2"]
+    central, shared = tmp_path / "central", tmp_path / "shared"
+    assert main(["etsc/ClusterContainmentCentral-v0", *argv, "--out", str(central)]) == 0
+    assert main(["etsc/ClusterContainment-v0", *argv, "--out", str(shared)]) == 0
+    reused = tmp_path / "reused"
+    reuse = ["--reuse", str(central / "pareto.json")]
+    assert main(["etsc/ClusterContainment-v0", *argv, "--out", str(reused), *reuse]) == 0
+    curves = [
+        json.loads((folder / "pareto.json").read_text(encoding="utf-8"))["curves"]
+        for folder in (central, shared, reused)
+    ]
+    for name in ("paper", "periodic"):
+        assert curves[0][name] == curves[1][name] == curves[2][name]
+    with pytest.raises(SystemExit):
+        main(["etsc/AttitudeTracking-v0", *argv, *reuse])
