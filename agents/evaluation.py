@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import pickle
+import time
 from pathlib import Path
 from typing import Any
 
@@ -52,7 +53,11 @@ class PaperComparisonCallback(BaseCallback):
         env_kwargs: kwargs of the evaluation envs (the set's ``randomize`` replaces theirs).
         every: training steps between evaluations.
         out_path: JSON file that receives the list of evaluations after each one (each entry
-            ``{"timesteps", "learned": {...}, "paper": {...}}`` with :func:`set_summary`'s keys).
+            ``{"timesteps", "env_steps", "wall_time_s", "learned": {...}, "paper": {...}}`` with
+            :func:`set_summary`'s keys; ``env_steps`` counts the sampling instants simulated
+            for training so far — equal to ``timesteps`` per instant, the sum of the decisions'
+            ``info["elapsed_steps"]`` for self-triggered decisions — and ``wall_time_s`` the
+            training time since the start, evaluations included).
         set_size: validation scenarios per evaluation.
         best_model_path: where the model with the highest mean validation return so far is
             saved (with its observation statistics beside it), or ``None``.
@@ -89,6 +94,9 @@ class PaperComparisonCallback(BaseCallback):
         self._next_evaluation = every
         self.decisions = decisions
         self._deployment: tuple[IntervalSchedule, Any, Any] | None = None
+        self.env_steps = 0
+        self._started = time.perf_counter()
+        self._earlier_wall_time_s = 0.0
 
     def _on_training_start(self) -> None:
         setup = episode_setup(self.env_id, self.env_kwargs)
@@ -100,8 +108,11 @@ class PaperComparisonCallback(BaseCallback):
         setup.env.close()
         self.paper = set_summary(self._run(paper_trigger))
         self._next_evaluation = self.num_timesteps + self.every
+        self._started = time.perf_counter()
 
     def _on_step(self) -> bool:
+        infos = self.locals.get("infos") or ()
+        self.env_steps += sum(int(info.get("elapsed_steps", 1)) for info in infos)
         if self.num_timesteps < self._next_evaluation:
             return True
         self._next_evaluation += self.every
@@ -109,6 +120,8 @@ class PaperComparisonCallback(BaseCallback):
         self.evaluations.append(
             {
                 "timesteps": self.num_timesteps,
+                "env_steps": self.env_steps,
+                "wall_time_s": self._earlier_wall_time_s + time.perf_counter() - self._started,
                 "scenarios": self.scenarios.describe(),
                 "learned": learned,
                 "paper": self.paper,
@@ -128,6 +141,9 @@ class PaperComparisonCallback(BaseCallback):
         """Continue an interrupted run: keep its evaluations (up to the resumed checkpoint)
         and its best validation return so far."""
         self.evaluations = list(history)
+        if history:
+            self.env_steps = int(history[-1].get("env_steps", history[-1]["timesteps"]))
+            self._earlier_wall_time_s = float(history[-1].get("wall_time_s", 0.0))
         returns = [entry["learned"].get("return") for entry in history if "learned" in entry]
         self.best_return = max((r for r in returns if r is not None), default=-np.inf)
 

@@ -3,6 +3,8 @@ shield, and a short training run that reloads through ``sb3:`` (short horizons).
 
 from __future__ import annotations
 
+import json
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -244,6 +246,10 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
     for name in ("model", "best_model", "checkpoints/model_32_steps"):
         assert DecisionSet.load(out_dir / f"{name}.zip").shield_multiple == 2.0
     assert takes_action_masks(load_sb3(out_dir / "model.zip"))  # normalised MaskablePPO
+    evaluations = json.loads((out_dir / "evaluations.json").read_text(encoding="utf-8"))
+    # a decision lasts one instant or more: the instants simulated outrun the decisions
+    assert [entry["timesteps"] for entry in evaluations] == [32, 64]
+    assert all(entry["env_steps"] > entry["timesteps"] for entry in evaluations)
     result = evaluate(FORMATION, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
     assert result["episodes"][0]["transmissions"] > 0
 

@@ -476,6 +476,10 @@ def test_resume_keeps_the_evaluation_history(tmp_path: Path) -> None:
     after = _evaluations(out_dir)
     assert after[: len(before)] == before
     assert [entry["timesteps"] for entry in after] == [64, 128, 192, 256, 320]
+    # one instant per training step here, counted on across the resume
+    assert [entry["env_steps"] for entry in after] == [64, 128, 192, 256, 320]
+    wall_times = [entry["wall_time_s"] for entry in after]
+    assert wall_times == sorted(wall_times) and wall_times[0] > 0
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,184 @@
+"""How fast each decision structure learns: validation curves of training runs against
+simulated instants and wall-clock time.
+
+    python -m agents.learning_curves --run LABEL=RUN_DIR [--run LABEL=RUN_DIR ...]
+                                     [--cost-tolerance 1.05] [--out DIR]
+
+Each ``RUN_DIR`` is the output folder of ``python -m agents.train`` (its ``evaluations.json``:
+the policy and the paper trigger on the validation scenarios, with the sampling instants
+simulated for training so far and the training wall time at every evaluation). Runs with the
+same ``LABEL`` (one method, several training seeds) are drawn in one colour and summarised
+together.
+
+A run **reaches the paper trigger** at its first evaluation whose validation ``mean_cost`` is
+at most ``cost_tolerance`` times the paper trigger's and whose transmissions are at most the
+paper trigger's: as accurate (within the goal's tolerance) on no more transmissions. Cost alone
+would be reached by a policy that transmits at every instant. The report gives, per run, the
+instants and seconds it took (``null`` if it never did) and, per label, the median and range
+over the runs that reached it.
+
+Writes ``learning_curves.json`` and ``learning_curves.png`` (cost and transmissions relative to
+the paper trigger against instants and against seconds) into ``DIR`` (default
+``results/learning_curves``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from baselines.cli import write_json
+from baselines.plotting import save
+from etsc_envs.core.files import output_folder_argument, require_writable_folder
+
+DEFAULT_COST_TOLERANCE = 1.05
+"""The goal's cost tolerance: within 5 % of the paper trigger's ``mean_cost``."""
+
+
+def parse_runs(specs: list[str]) -> list[tuple[str, Path]]:
+    """``LABEL=RUN_DIR`` pairs, each folder holding an ``evaluations.json``."""
+    runs = []
+    for spec in specs:
+        label, separator, folder = spec.partition("=")
+        if not separator or not label or not folder:
+            raise ValueError(f"--run must be LABEL=RUN_DIR, got {spec!r}")
+        path = Path(folder) / "evaluations.json"
+        if not path.is_file():
+            raise ValueError(f"--run {spec}: no evaluations.json in {folder}")
+        runs.append((label, Path(folder)))
+    if not runs:
+        raise ValueError("--run: give at least one LABEL=RUN_DIR")
+    return runs
+
+
+def run_curve(folder: Path, cost_tolerance: float) -> dict[str, Any]:
+    """One run's validation curve relative to the paper trigger, and where it reached it."""
+    evaluations = json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
+    missing = [entry["timesteps"] for entry in evaluations if "env_steps" not in entry]
+    if missing:
+        raise ValueError(
+            f"{folder}: evaluations at {missing} record no env_steps (trained before they "
+            f"were logged); retrain to compare learning speed"
+        )
+    points = []
+    for entry in evaluations:
+        learned, paper = entry["learned"], entry["paper"]
+        points.append(
+            {
+                "timesteps": entry["timesteps"],
+                "env_steps": entry["env_steps"],
+                "wall_time_s": entry["wall_time_s"],
+                "cost_ratio": learned["mean_cost"] / paper["mean_cost"],
+                "transmission_ratio": learned["transmissions"] / paper["transmissions"],
+                "failures": learned["failures"],
+            }
+        )
+    reached = next(
+        (
+            point
+            for point in points
+            if point["cost_ratio"] <= cost_tolerance
+            and point["transmission_ratio"] <= 1.0
+            and point["failures"] <= evaluations[0]["paper"]["failures"]
+        ),
+        None,
+    )
+    return {
+        "run": str(folder),
+        "points": points,
+        "reached_at_env_steps": None if reached is None else reached["env_steps"],
+        "reached_at_wall_time_s": None if reached is None else reached["wall_time_s"],
+    }
+
+
+def _spread(values: list[float]) -> dict[str, Any]:
+    if not values:
+        return {"median": None, "range": None}
+    return {"median": float(np.median(values)), "range": [min(values), max(values)]}
+
+
+def learning_curves(runs: list[tuple[str, Path]], cost_tolerance: float) -> dict[str, Any]:
+    """Every run's curve, grouped by label, with the per-label summary of the module
+    docstring."""
+    if not cost_tolerance >= 1.0:
+        raise ValueError(f"--cost-tolerance must be at least 1, got {cost_tolerance!r}")
+    methods: dict[str, dict[str, Any]] = {}
+    for label, folder in runs:
+        methods.setdefault(label, {"runs": []})["runs"].append(run_curve(folder, cost_tolerance))
+    for method in methods.values():
+        reached = [run for run in method["runs"] if run["reached_at_env_steps"] is not None]
+        method["reached"] = f"{len(reached)}/{len(method['runs'])}"
+        method["env_steps_to_reach"] = _spread([run["reached_at_env_steps"] for run in reached])
+        method["wall_time_s_to_reach"] = _spread([run["reached_at_wall_time_s"] for run in reached])
+    return {"cost_tolerance": cost_tolerance, "methods": methods}
+
+
+def plot(result: dict[str, Any], path: Path) -> None:
+    """Cost and transmissions relative to the paper trigger, against instants and seconds."""
+    figure, axes = plt.subplots(2, 2, figsize=(11, 7), sharey="row")
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for index, (label, method) in enumerate(result["methods"].items()):
+        colour = colours[index % len(colours)]
+        for run_index, run in enumerate(method["runs"]):
+            points = run["points"]
+            for column, x_key in enumerate(("env_steps", "wall_time_s")):
+                x = [point[x_key] for point in points]
+                for row, y_key in enumerate(("cost_ratio", "transmission_ratio")):
+                    axes[row, column].plot(
+                        x,
+                        [point[y_key] for point in points],
+                        color=colour,
+                        alpha=0.8,
+                        marker=".",
+                        label=label if run_index == 0 and row == column == 0 else None,
+                    )
+    for row, name in enumerate(("mean_cost / paper", "transmissions / paper")):
+        axes[row, 0].set_ylabel(name)
+        for column in range(2):
+            axes[row, column].axhline(1.0, color="k", linewidth=0.8, linestyle=":")
+            axes[row, column].set_yscale("log")
+            axes[row, column].grid(True, which="major", alpha=0.3)
+    axes[0, 0].axhline(result["cost_tolerance"], color="k", linewidth=0.8, linestyle="--")
+    axes[1, 0].set_xlabel("sampling instants simulated for training")
+    axes[1, 1].set_xlabel("training wall time (s)")
+    figure.legend(loc="lower center", ncol=4, frameon=False)
+    figure.suptitle("validation scenarios: learned trigger relative to the paper's", fontsize=11)
+    figure.tight_layout(rect=(0, 0.06, 1, 0.95))
+    save(figure, path)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m agents.learning_curves",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--run", action="append", default=[], metavar="LABEL=RUN_DIR")
+    parser.add_argument("--cost-tolerance", type=float, default=DEFAULT_COST_TOLERANCE)
+    parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
+    args = parser.parse_args(argv)
+    out_dir = args.out or Path("results") / "learning_curves"
+    try:
+        require_writable_folder(out_dir, "--out")
+        result = learning_curves(parse_runs(args.run), args.cost_tolerance)
+    except (ValueError, OSError, KeyError) as error:
+        parser.error(str(error))
+    write_json(result, str(out_dir / "learning_curves.json"))
+    plot(result, out_dir / "learning_curves.png")
+    for label, method in result["methods"].items():
+        steps, seconds = method["env_steps_to_reach"], method["wall_time_s_to_reach"]
+        print(
+            f"{label}: reached the paper trigger in {method['reached']} runs; instants "
+            f"{steps['median']} {steps['range']}, seconds {seconds['median']} {seconds['range']}"
+        )
+    print(f"wrote {out_dir / 'learning_curves.json'} and {out_dir / 'learning_curves.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,75 @@
+"""``python -m agents.learning_curves``: when a run first matches the paper trigger."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from agents.learning_curves import learning_curves, main, parse_runs
+
+PAPER = {"mean_cost": 1.0, "transmissions": 100.0, "failures": 0}
+
+
+def _run(folder: Path, points: list[tuple[float, float, int]], instants_per_step: int) -> Path:
+    """A run folder whose evaluations have the (cost, transmissions, failures) ``points``."""
+    folder.mkdir(parents=True)
+    evaluations = [
+        {
+            "timesteps": 10 * (index + 1),
+            "env_steps": 10 * (index + 1) * instants_per_step,
+            "wall_time_s": 2.0 * (index + 1),
+            "learned": {"mean_cost": cost, "transmissions": sent, "failures": failures},
+            "paper": PAPER,
+        }
+        for index, (cost, sent, failures) in enumerate(points)
+    ]
+    (folder / "evaluations.json").write_text(json.dumps(evaluations), encoding="utf-8")
+    return folder
+
+
+def test_a_run_reaches_the_paper_trigger_when_as_accurate_on_no_more_transmissions(
+    tmp_path: Path,
+) -> None:
+    always = _run(tmp_path / "always", [(0.5, 1000.0, 0), (0.9, 400.0, 0)], 1)
+    # too costly, then a failure, then within 5 % on fewer transmissions
+    late = _run(tmp_path / "late", [(1.2, 50.0, 0), (1.0, 60.0, 1), (1.04, 70.0, 0)], 100)
+    result = learning_curves(
+        parse_runs([f"instant={always}", f"decisions={late}"]), cost_tolerance=1.05
+    )
+    instant, decisions = result["methods"]["instant"], result["methods"]["decisions"]
+    assert instant["reached"] == "0/1" and instant["env_steps_to_reach"]["median"] is None
+    assert decisions["reached"] == "1/1"
+    assert decisions["runs"][0]["reached_at_env_steps"] == 3000
+    assert decisions["wall_time_s_to_reach"] == {"median": 6.0, "range": [6.0, 6.0]}
+
+
+def test_seeds_of_a_method_are_summarised_together(tmp_path: Path) -> None:
+    runs = [
+        _run(tmp_path / f"seed{seed}", [(2.0, 50.0, 0)] * seed + [(1.0, 50.0, 0)], 1)
+        for seed in range(3)
+    ]
+    out = tmp_path / "out"
+    argv = [arg for run in runs for arg in ("--run", f"ppo={run}")]
+    assert main([*argv, "--out", str(out)]) == 0
+    result = json.loads((out / "learning_curves.json").read_text(encoding="utf-8"))
+    assert result["methods"]["ppo"]["env_steps_to_reach"] == {"median": 20.0, "range": [10, 30]}
+    assert (out / "learning_curves.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("spec", ["no-separator", "=folder", "label="])
+def test_a_malformed_run_names_the_option(spec: str, capsys) -> None:
+    with pytest.raises(SystemExit):
+        main(["--run", spec])
+    assert "--run" in capsys.readouterr().err
+
+
+def test_a_run_without_instants_is_refused(tmp_path: Path, capsys) -> None:
+    folder = _run(tmp_path / "old", [(1.0, 50.0, 0)], 1)
+    entries = json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
+    del entries[0]["env_steps"]
+    (folder / "evaluations.json").write_text(json.dumps(entries), encoding="utf-8")
+    with pytest.raises(SystemExit):
+        main(["--run", f"old={folder}", "--out", str(tmp_path / "out")])
+    assert "env_steps" in capsys.readouterr().err
