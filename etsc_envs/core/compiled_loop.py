@@ -21,6 +21,10 @@ page's step semantics are written once:
 5. the reward is ``-cost/cost_scale - transmission_penalty * (channels sent)``, in total and
    per channel (each channel pays its own cost, its own transmissions and an equal share of a
    failure charge, so the per-channel rewards sum to the total).
+
+:func:`make_loop_interval` compiles, around the same step, an interval of several instants
+(a first action, then holds) in one call, for decisions that hold the channel for many
+instants (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`).
 """
 
 from __future__ import annotations
