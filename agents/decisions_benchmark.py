@@ -5,7 +5,8 @@
 For each id, two policies: a fixed hold of 2^6 instants, and uniformly random decisions (the
 default decision set: holds 1..1024 and the paper's rule with its threshold scaled by 0.5, 1, 2
 or 4). Each figure is the median [min-max] of ``R`` timed runs after an untimed warm-up, in
-decisions per second and in env steps (sampling instants) per second; the env is the id's
+decisions per second and in env steps (sampling instants) per second, per second of wall time
+and per second of the process's CPU time (steadier on a shared machine); the env is the id's
 default scenario made by ``gym.make``, reset inside the timed loop when an episode ends.
 ``--per-instant`` puts a plain ``gym.Wrapper`` between the decision wrapper and the env, so
 that every instant is one ``env.step`` call (the design before the compiled holds).
@@ -28,13 +29,14 @@ HOLD_ACTION = 6
 """Hold 2^6 = 64 instants."""
 DECISIONS = {"hold": 3000, "random": 2000}
 """Decisions per timed run."""
+RATES = ("decisions_per_s", "steps_per_s", "decisions_per_cpu_s", "steps_per_cpu_s")
 
 
 def time_decisions(
     wrapper: SelfTriggeredWrapper, policy: str, decisions: int, seed: int
-) -> tuple[float, int]:
-    """Seconds taken by ``decisions`` decisions of ``policy`` (``"hold"`` or ``"random"``),
-    and the env steps they ran."""
+) -> tuple[float, float, int]:
+    """Wall and CPU seconds taken by ``decisions`` decisions of ``policy`` (``"hold"`` or
+    ``"random"``), and the env steps they ran."""
     rng = np.random.default_rng(seed)
     n_actions = int(wrapper.action_space.n)
     actions = (
@@ -44,13 +46,13 @@ def time_decisions(
     )
     wrapper.reset(seed=seed)
     steps = 0
-    start = time.perf_counter()
+    start, start_cpu = time.perf_counter(), time.process_time()
     for action in actions:
         _, _, terminated, truncated, info = wrapper.step(int(action))
         steps += info["elapsed_steps"]
         if terminated or truncated:
             wrapper.reset()
-    return time.perf_counter() - start, steps
+    return time.perf_counter() - start, time.process_time() - start_cpu, steps
 
 
 def make_wrapper(env_id: str, per_instant: bool) -> SelfTriggeredWrapper:
@@ -61,15 +63,17 @@ def make_wrapper(env_id: str, per_instant: bool) -> SelfTriggeredWrapper:
 
 
 def rates(env_id: str, policy: str, repeats: int, per_instant: bool) -> dict[str, list[float]]:
-    """Decisions/s and env steps/s of ``repeats`` timed runs after a warm-up."""
+    """Decisions and env steps per wall and per CPU second of ``repeats`` timed runs after a
+    warm-up."""
     wrapper = make_wrapper(env_id, per_instant)
     decisions = DECISIONS[policy]
     time_decisions(wrapper, policy, decisions, seed=repeats)
-    record: dict[str, list[float]] = {"decisions_per_s": [], "steps_per_s": []}
+    record: dict[str, list[float]] = {name: [] for name in RATES}
     for seed in range(repeats):
-        seconds, steps = time_decisions(wrapper, policy, decisions, seed)
-        record["decisions_per_s"].append(decisions / seconds)
-        record["steps_per_s"].append(steps / seconds)
+        wall, cpu, steps = time_decisions(wrapper, policy, decisions, seed)
+        pairs = ((decisions, wall), (steps, wall), (decisions, cpu), (steps, cpu))
+        for name, (work, seconds) in zip(RATES, pairs, strict=True):
+            record[name].append(work / seconds)
     return record
 
 
@@ -89,11 +93,8 @@ def main(argv: list[str] | None = None) -> int:
     for env_id in args.env:
         for policy in DECISIONS:
             record = rates(env_id, policy, args.repeats, args.per_instant)
-            print(
-                f"{env_id} {policy}: {summary(record['decisions_per_s'])} decisions/s, "
-                f"{summary(record['steps_per_s'])} steps/s",
-                flush=True,
-            )
+            figures = ", ".join(f"{summary(record[name])} {name}" for name in RATES)
+            print(f"{env_id} {policy}: {figures}", flush=True)
     return 0
 
 
