@@ -3,7 +3,12 @@
 One step of :class:`SelfTriggeredWrapper` is one decision of :mod:`baselines.self_triggered`:
 hold 2^j instants after transmitting now, or hand the interval to the paper's trigger with its
 threshold scaled by f. The wrapper runs the interval on the unchanged env and returns the
-observation of the next decision instant. Its reward is the interval's rewards discounted
+observation of the next decision instant. A hold's instants run in one compiled call
+(:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`) when only ``gym.make``'s
+order-enforcing and passive-checker wrappers lie between the wrapper and the loop env (neither
+acts on a step once the env is reset and its first step checked); under any other wrapper
+(``TimeLimit``, say) every instant goes through ``env.step``. The paper's rule decides each
+instant in Python, one ``env.step`` each. Its reward is the interval's rewards discounted
 within it, ``sum_i gamma**i * r_i`` over the ``n`` instants it ran, and ``info["elapsed_steps"]
 = n``, so that an algorithm discounting the next decision by ``gamma**n`` keeps the meaning of
 the per-instant return: Stable-Baselines3 discounts every decision by one constant ``gamma``
@@ -21,6 +26,7 @@ from typing import Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
+from gymnasium.wrappers import OrderEnforcing, PassiveEnvChecker
 
 from baselines.self_triggered import (
     DEFAULT_MAX_EXPONENT,
@@ -28,6 +34,22 @@ from baselines.self_triggered import (
     IntervalSchedule,
     default_factors,
 )
+from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.validation import require_discount
+
+STEP_TRANSPARENT_WRAPPERS = (OrderEnforcing, PassiveEnvChecker)
+"""Wrappers of ``gym.make`` that a compiled interval may bypass: after ``reset`` neither changes
+a step (the checker only inspects the first step that reaches it)."""
+
+
+def interval_env(env: gym.Env) -> EventTriggeredEnv | None:
+    """The loop env under ``env`` if only :data:`STEP_TRANSPARENT_WRAPPERS` (exactly those
+    classes) wrap it, so that its compiled intervals equal stepping ``env``; ``None`` otherwise."""
+    while isinstance(env, gym.Wrapper):
+        if type(env) not in STEP_TRANSPARENT_WRAPPERS:
+            return None
+        env = env.env
+    return env if isinstance(env, EventTriggeredEnv) else None
 
 
 class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
@@ -63,8 +85,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
             raise ValueError("env must be made by gym.make (its id names the paper trigger)")
-        if not 0.0 < gamma <= 1.0:
-            raise ValueError(f"gamma must be in (0, 1], got {gamma!r}")
+        self.gamma = require_discount("gamma", gamma)
         unwrapped = env.unwrapped
         self.decisions = DecisionSet(
             env.spec.id,
@@ -76,10 +97,10 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names
         )
-        self.gamma = float(gamma)
         self.action_space = self.decisions.action_space
         self._observation: np.ndarray | None = None
         self._hold_action = np.zeros(env.action_space.shape, dtype=np.int64)
+        self._loop = interval_env(env)
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -108,17 +129,13 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         state = self.schedule.start(chosen)
         total, steps = 0.0, 0
         while True:
+            decision, state = self.schedule.transmit(obs, state)
             held = int(self.schedule.unconditional_holds(state)[0])
-            actions = [self._hold_action] * held
-            if not held:
-                decision, state = self.schedule.transmit(obs, state)
-                actions = [decision[0].astype(np.int64)]
-            for action_now in actions:
-                observation, reward, terminated, truncated, info = self.env.step(action_now)
-                total += self.gamma**steps * float(reward)
-                steps += 1
-                if terminated or truncated:
-                    break
+            observation, reward, terminated, truncated, info, run = self._run(
+                decision[0].astype(np.int64), 1 + held
+            )
+            total += self.gamma**steps * reward
+            steps += run
             state = state + np.array([0, held])
             obs = observation[None]
             if terminated or truncated or self.schedule.interval_over(obs, state)[0]:
@@ -131,3 +148,20 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             "shielded": bool(chosen[0] != given),
         }
         return observation, total, terminated, truncated, info
+
+    def _run(
+        self, first_action: np.ndarray, instants: int
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
+        """``first_action`` then holds, for ``instants`` instants or to the episode's end:
+        ``(observation, sum_k gamma**k * reward_k, terminated, truncated, info, instants run)``
+        (in one compiled call where :func:`interval_env` allows it)."""
+        if instants > 1 and self._loop is not None:
+            return self._loop.run_interval(first_action, instants, self.gamma)
+        action, total = first_action, 0.0
+        for instant in range(instants):
+            observation, reward, terminated, truncated, info = self.env.step(action)
+            total += self.gamma**instant * float(reward)
+            action = self._hold_action
+            if terminated or truncated:
+                break
+        return observation, total, terminated, truncated, info, instant + 1

@@ -11,7 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.decisions import SelfTriggeredWrapper
+from agents.decisions import SelfTriggeredWrapper, interval_env
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.evaluate import evaluate
@@ -123,6 +123,46 @@ def test_deployed_policy_takes_the_training_decisions(env_id, shield):
     actions, infos = wrapper_actions(env_id, model, **kwargs)
     assert len({info["action"] for info in infos}) > 3
     assert_same(actions, policy_actions(env_id, deployed(env_id, model, **kwargs)))
+
+
+def decision_episode(env: gym.Env, model, **kwargs) -> list[tuple]:
+    """Every decision's result of one seeded episode of the wrapper over ``env``."""
+    wrapper = SelfTriggeredWrapper(env, **kwargs)
+    obs, _ = wrapper.reset(seed=SEED)
+    results, done = [], False
+    while not done:
+        action, _ = model.predict(obs[None])
+        result = wrapper.step(action[0])
+        obs, done = result[0], result[2] or result[3]
+        results.append(result)
+    return results
+
+
+@pytest.mark.parametrize(("env_id", "shield"), [(ATTITUDE, None), (FORMATION, 0.5)])
+def test_compiled_holds_equal_the_per_instant_path(env_id, shield):
+    """Under gym.make's own wrappers the holds run in compiled intervals; under any other
+    wrapper (here the recorder) every instant is an env.step; both give the same episode."""
+    kwargs = {"max_exponent": 5, "shield_multiple": shield}
+    model = ScriptedModel(DecisionSet(env_id, max_exponent=5).action_space.n)
+    plain, recorder = gym.make(env_id, horizon_s=HORIZON_S), recorded(env_id)
+    assert interval_env(plain) is plain.unwrapped and interval_env(recorder) is None
+    compiled = decision_episode(plain, model, **kwargs)
+    stepwise = decision_episode(recorder, model, **kwargs)
+    assert len(compiled) == len(stepwise) > 10
+    assert len({info["action"] for *_, info in compiled}) > 3
+    for got, expected in zip(compiled, stepwise, strict=True):
+        np.testing.assert_array_equal(got[0], expected[0])
+        np.testing.assert_equal(list(got[1:]), list(expected[1:]))
+
+
+def test_a_time_limit_sees_every_instant_of_a_hold():
+    env = gym.make(ATTITUDE, horizon_s=HORIZON_S, max_episode_steps=50)
+    assert interval_env(env) is None
+    wrapper = SelfTriggeredWrapper(env, max_exponent=6)
+    wrapper.reset(seed=SEED)
+    _, _, terminated, truncated, info = wrapper.step(6)  # hold 64
+    assert truncated and not terminated and info["elapsed_steps"] == 50
+    assert "episode_metrics" not in info  # the time limit, not the env's horizon, cut it
 
 
 def test_shield_lets_no_forbidden_hold_through():

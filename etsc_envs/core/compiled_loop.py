@@ -21,6 +21,10 @@ page's step semantics are written once:
 5. the reward is ``-cost/cost_scale - transmission_penalty * (channels sent)``, in total and
    per channel (each channel pays its own cost, its own transmissions and an equal share of a
    failure charge, so the per-channel rewards sum to the total).
+
+:func:`make_loop_interval` compiles, around the same step, an interval of several instants
+(a first action, then holds) in one call, for decisions that hold the channel for many
+instants (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`).
 """
 
 from __future__ import annotations
@@ -230,6 +234,75 @@ def make_loop_step(kernels: ProblemKernels) -> Callable[..., None]:
                 )
 
     return loop_step
+
+
+def make_loop_interval(loop_step: Callable[..., None]) -> Callable[..., None]:
+    """Compile an interval of several sampling instants around a compiled ``loop_step``.
+
+    The compiled function has the signature ``interval(first_actions, active, arrays,
+    constants, h, n_steps, cost_scale, transmission_penalty, failure_cost, instants, gamma,
+    discounted, steps_run, step_costs, step_sent)``; the arguments up to ``failure_cost`` are
+    ``loop_step``'s. Each active row runs ``loop_step`` with its ``first_actions`` at the first
+    instant and all-zero actions (hold) after, for ``instants`` instants or until it fails or
+    reaches the horizon ``n_steps``, whichever comes first. Per row it writes
+    ``discounted = sum_k gamma**k * reward_k`` over the instants run (summed in order, as a
+    Python loop over the steps would), ``steps_run``, and each instant's accuracy cost and
+    transmit bits in ``step_costs[:, k]`` and ``step_sent[:, k]`` (``(n, >= instants)`` and
+    ``(n, >= instants, C)`` arrays). The loop arrays end exactly as after ``steps_run`` calls of
+    ``loop_step``, so the step semantics stay those of :func:`make_loop_step`.
+    """
+
+    @closure_jit
+    def loop_interval(
+        first_actions,
+        active,
+        arrays,
+        constants,
+        h,
+        n_steps,
+        cost_scale,
+        transmission_penalty,
+        failure_cost,
+        instants,
+        gamma,
+        discounted,
+        steps_run,
+        step_costs,
+        step_sent,
+    ):
+        running = active.copy()
+        discounted[:] = 0.0
+        steps_run[:] = 0
+        actions = first_actions
+        hold = np.zeros_like(first_actions)
+        for instant in range(instants):
+            loop_step(
+                actions,
+                running,
+                arrays,
+                constants,
+                h,
+                n_steps,
+                cost_scale,
+                transmission_penalty,
+                failure_cost,
+            )
+            discount = gamma ** float(instant)
+            any_running = False
+            for i in range(running.shape[0]):
+                if not running[i]:
+                    continue
+                discounted[i] += discount * arrays.reward[i]
+                step_costs[i, instant] = arrays.cost[i]
+                step_sent[i, instant] = arrays.sent[i]
+                steps_run[i] = instant + 1
+                running[i] = arrays.failure_code[i] == 0 and arrays.step_index[i] < n_steps
+                any_running = any_running or running[i]
+            if not any_running:
+                break
+            actions = hold
+
+    return loop_interval
 
 
 def compiled_entry(dispatcher: Any, *args: Any) -> Callable[..., Any]:

@@ -27,6 +27,7 @@ loop arrays, so a vector environment can bind many such environments to the rows
 
 from __future__ import annotations
 
+from collections import namedtuple
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -38,6 +39,7 @@ from etsc_envs.core.compiled_loop import (
     ProblemKernels,
     allocate_loop_arrays,
     compiled_entry,
+    make_loop_interval,
     make_loop_step,
 )
 from etsc_envs.core.metrics import communication_metrics
@@ -45,6 +47,8 @@ from etsc_envs.core.render import RENDER_MODES, EpisodeTrace, draw_frame
 from etsc_envs.core.validation import (
     require_bool,
     require_choice,
+    require_discount,
+    require_int_at_least,
     require_non_negative,
     require_positive,
     require_reset_options,
@@ -87,6 +91,7 @@ class EventTriggeredEnv(gym.Env):
     metadata: ClassVar[dict[str, Any]] = {"render_modes": list(RENDER_MODES), "render_fps": 10}
     kernels: ClassVar[ProblemKernels]
     loop_step: ClassVar[Callable[..., None]]
+    loop_interval: ClassVar[Callable[..., None]]
     reset_options: ClassVar[tuple[str, ...]] = ()
     """The keys ``reset(options=...)`` accepts."""
 
@@ -94,6 +99,7 @@ class EventTriggeredEnv(gym.Env):
         super().__init_subclass__(**kwargs)
         if "kernels" in cls.__dict__:
             cls.loop_step = staticmethod(make_loop_step(cls.kernels))
+            cls.loop_interval = staticmethod(make_loop_interval(cls.loop_step))
 
     def __init__(
         self,
@@ -145,6 +151,7 @@ class EventTriggeredEnv(gym.Env):
         self._actions = np.zeros((1, n_channels), dtype=np.int64)
         self._active = np.ones(1, dtype=bool)
         self._has_reset = False
+        self._interval_outputs = _interval_outputs(1, n_channels)
         self.bind(allocate_loop_arrays(1, *self.loop_shape))
 
     def bind(self, arrays: LoopArrays) -> None:
@@ -152,12 +159,14 @@ class EventTriggeredEnv(gym.Env):
         self.arrays = arrays
         self.state = arrays.state[0]
         self._loop_step_entry = None
+        self._loop_interval_entry = None
 
     def __getstate__(self) -> dict[str, Any]:
-        """Everything but the compiled entry point (machine code, not picklable; rebuilt from
+        """Everything but the compiled entry points (machine code, not picklable; rebuilt from
         the disk cache on the next step)."""
         state = self.__dict__.copy()
         state["_loop_step_entry"] = None
+        state["_loop_interval_entry"] = None
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -258,16 +267,67 @@ class EventTriggeredEnv(gym.Env):
         return {"transmitted": 0, "transmissions": 0, "time_s": 0.0, "cost": 0.0}
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        self._require_running("step")
+        self._set_transmit_bits("action", action)
+        arguments = self._loop_arguments()
+        if self._loop_step_entry is None:
+            self._loop_step_entry = compiled_entry(self.loop_step, *arguments)
+        self._loop_step_entry(*arguments)
+        self.trace_step()
+        observation, terminated, truncated, info = self._outcome()
+        return observation, float(self.arrays.reward[0]), terminated, truncated, info
+
+    def run_interval(
+        self, first_action: Any, instants: int, gamma: float = 1.0
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
+        """Run up to ``instants`` sampling instants in one compiled call: ``first_action`` at
+        the first, hold (every channel 0) at the others, stopping early at a failure or at the
+        horizon.
+
+        The episode (state, step counter, metrics, ``render`` trace) ends exactly as after the
+        same actions given to :meth:`step` one instant at a time. Returns ``(observation,
+        discounted_reward, terminated, truncated, info, steps_run)``: the observation,
+        ``terminated``, ``truncated`` and ``info`` of the last instant run, ``sum_k gamma**k *
+        reward_k`` over the ``steps_run`` instants run (summed in order, as a Python loop over
+        :meth:`step`'s rewards would). ``ValueError`` naming the argument if ``first_action``
+        is not an action, ``instants`` not an integer >= 1 or ``gamma`` not in (0, 1].
+        """
+        self._require_running("run_interval")
+        instants = require_int_at_least("instants", instants, 1)
+        gamma = require_discount("gamma", gamma)
+        self._set_transmit_bits("first_action", first_action)
+        outputs = self._interval_outputs
+        if outputs.step_costs.shape[1] < instants:
+            outputs = self._interval_outputs = _interval_outputs(instants, self.n_channels)
+        arguments = (*self._loop_arguments(), instants, gamma, *outputs)
+        if self._loop_interval_entry is None:
+            self._loop_interval_entry = compiled_entry(self.loop_interval, *arguments)
+        start = self.step_index
+        self._loop_interval_entry(*arguments)
+        steps_run = int(outputs.steps_run[0])
+        if self._trace is not None:
+            for instant in range(steps_run):
+                time_s = (start + instant + 1) * self.sampling_period_s
+                sent = outputs.step_sent[0, instant]
+                self._trace.record(time_s, float(outputs.step_costs[0, instant]), sent)
+        observation, terminated, truncated, info = self._outcome()
+        discounted = float(outputs.discounted[0])
+        return observation, discounted, terminated, truncated, info, steps_run
+
+    def _require_running(self, method: str) -> None:
+        """``ResetNeeded`` before the first reset, ``RuntimeError`` after the episode ended."""
         arrays = self.arrays
         if not self._has_reset:
-            raise gym.error.ResetNeeded("step() called before reset(); call reset() first")
+            raise gym.error.ResetNeeded(f"{method}() called before reset(); call reset() first")
         if arrays.failure_code[0] != 0 or arrays.step_index[0] >= self.n_steps:
-            raise RuntimeError("step() called after the episode ended; call reset() first")
-        self._set_transmit_bits(action)
-        arguments = (
+            raise RuntimeError(f"{method}() called after the episode ended; call reset() first")
+
+    def _loop_arguments(self) -> tuple[Any, ...]:
+        """The arguments of the compiled loop step for this env's row and stored actions."""
+        return (
             self._actions,
             self._active,
-            arrays,
+            self.arrays,
             self.constants,
             self.sampling_period_s,
             self.n_steps,
@@ -275,19 +335,14 @@ class EventTriggeredEnv(gym.Env):
             self.transmission_penalty,
             self.failure_cost,
         )
-        if self._loop_step_entry is None:
-            self._loop_step_entry = compiled_entry(self.loop_step, *arguments)
-        self._loop_step_entry(*arguments)
-        self.trace_step()
+
+    def _outcome(self) -> tuple[np.ndarray, bool, bool, dict[str, Any]]:
+        """The observation, ``terminated``, ``truncated`` and ``info`` of the last step."""
+        arrays = self.arrays
         terminated = bool(arrays.failure_code[0] != 0)
         truncated = bool(not terminated and arrays.step_index[0] >= self.n_steps)
-        return (
-            arrays.observation[0].copy(),
-            float(arrays.reward[0]),
-            terminated,
-            truncated,
-            self.step_info(terminated or truncated),
-        )
+        info = self.step_info(terminated or truncated)
+        return arrays.observation[0].copy(), terminated, truncated, info
 
     def step_info(self, ended: bool) -> dict[str, Any]:
         """The ``info`` of the last step (with ``failure`` and ``episode_metrics`` if it ended
@@ -348,8 +403,9 @@ class EventTriggeredEnv(gym.Env):
         return ("channel",) if self.n_channels == 1 else tuple(map(str, range(self.n_channels)))
 
     # ----------------------------------------------------------------- internals
-    def _set_transmit_bits(self, action: Any) -> None:
-        """Store the action as one 0/1 per channel, or ``ValueError`` naming what is allowed."""
+    def _set_transmit_bits(self, name: str, action: Any) -> None:
+        """Store the action as one 0/1 per channel, or ``ValueError`` naming ``name`` and what
+        is allowed."""
         if self.n_channels == 1 and isinstance(action, int | np.integer) and action in (0, 1):
             self._actions[0, 0] = action  # the common case, without array checks
             return
@@ -357,5 +413,22 @@ class EventTriggeredEnv(gym.Env):
         n_channels = self.n_channels
         if bits.size != n_channels or not np.all((bits == 0) | (bits == 1)):
             allowed = "0 (hold) or 1 (transmit)" if n_channels == 1 else f"{n_channels} bits of 0/1"
-            raise ValueError(f"action must be {allowed}, got {action!r}")
+            raise ValueError(f"{name} must be {allowed}, got {action!r}")
         self._actions[0] = bits.reshape(n_channels)
+
+
+IntervalOutputs = namedtuple(
+    "IntervalOutputs", ["discounted", "steps_run", "step_costs", "step_sent"]
+)
+"""What the compiled interval writes for one row (see
+:func:`~etsc_envs.core.compiled_loop.make_loop_interval`)."""
+
+
+def _interval_outputs(capacity: int, n_channels: int) -> IntervalOutputs:
+    """Output arrays of the compiled interval for one row and up to ``capacity`` instants."""
+    return IntervalOutputs(
+        discounted=np.zeros(1),
+        steps_run=np.zeros(1, dtype=np.int64),
+        step_costs=np.zeros((1, capacity)),
+        step_sent=np.zeros((1, capacity, n_channels), dtype=np.int64),
+    )

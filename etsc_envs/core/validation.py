@@ -36,6 +36,26 @@ def require_non_negative(name: str, value: float) -> float:
     return value
 
 
+def require_int_at_least(name: str, value: int, minimum: int) -> int:
+    """``value`` as an ``int``, or ``ValueError`` unless it is an integer >= ``minimum`` (a
+    ``bool`` or a float such as ``2.0`` is refused)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(
+            f"{name} must be an integer >= {minimum}, got {value!r} ({type(value).__name__})"
+        )
+    if value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def require_discount(name: str, value: float) -> float:
+    """``value`` as a float, or ``ValueError`` unless it is a real number in (0, 1]."""
+    value = _real_number(name, value, "in (0, 1]")
+    if not 0.0 < value <= 1.0:
+        raise ValueError(f"{name} must be a finite number in (0, 1], got {value!r}")
+    return value
+
+
 def require_choice(name: str, value: str, choices: Iterable[str]) -> str:
     """``value``, or ``ValueError`` listing the allowed choices."""
     choices = tuple(choices)
