@@ -27,6 +27,7 @@ from etsc_envs.core.linalg import fused_dot
 from etsc_envs.core.rotations import se3_log
 from etsc_envs.orbit_attitude.controller import (
     ControllerGains,
+    adaptive_denominator,
     adaptive_derivative,
     adaptive_gain,
     control_law,
@@ -70,7 +71,10 @@ TORQUE_PHASE = slice(112, 115)  # phases of d_τ
 FORCE_PHASE = slice(115, 118)  # phases of d_f
 MISALIGNMENT = slice(118, 190)  # ΔD, 6×12 row-major
 TRUE_DISTRIBUTION = slice(190, 262)  # D + ΔD, 6×12 row-major (summed once per episode)
-STATE_WIDTH = 262
+HELD_COMMAND = slice(262, 268)  # the Γ_c THRUSTER_OUTPUT, HELD_WRENCH and HELD_FED were made of
+HELD_WRENCH = slice(268, 274)  # Γ_actual of Γ_c, eqs. (10)-(12)
+HELD_FED = slice(274, 280)  # what the ESO is fed for Γ_c (controller.eso_input)
+STATE_WIDTH = 280
 """Layout of the state row."""
 
 INTEGRAL = slice(14, 16)
@@ -116,8 +120,11 @@ def controller_view(t: float, y: np.ndarray, c: np.ndarray, gains: ControllerGai
     z2 = c[6:12]
     phi_hat = c[12:14]
     fixed_gain = fixed_gain_feedback(drift, z2, surface, gains)
-    command = control_law(fixed_gain, surface, adaptive_gain(phi_hat, c[14:16], surface, t, gains))
-    fresh = control_law(fixed_gain, surface, adaptive_gain(phi_hat, np.zeros(2), surface, t, gains))
+    denominator = adaptive_denominator(surface, t, gains)
+    integral = c[14:16]
+    command = control_law(fixed_gain, surface, adaptive_gain(phi_hat, integral, denominator, gains))
+    restarted = adaptive_gain(phi_hat, np.zeros(2), denominator, gains)
+    fresh = control_law(fixed_gain, surface, restarted)
     return eta, surface, drift, known, command, fresh
 
 
@@ -139,19 +146,19 @@ def total_disturbance(
     t: float,
     y: np.ndarray,
     wrench: np.ndarray,
-    held: np.ndarray,
+    fed: np.ndarray,
     known: np.ndarray,
     model: PlantModel,
     gains: ControllerGains,
 ) -> np.ndarray:
     """The true Δd = dṼ/dt - (H + Ξ⁻¹f(Ξ)) - Ξ⁻¹Γ_c of eq. (9), from the true plant.
 
-    ``wrench`` is what the thrusters really apply for the held command ``held``; Γ_c is what
-    the ESO is fed (:func:`~etsc_envs.orbit_attitude.controller.eso_input`), so Δd is exactly
-    the extended state Z2 the ESO estimates.
+    ``wrench`` is what the thrusters really apply for the held command; Γ_c here is ``fed``,
+    what the ESO is fed for it (:func:`~etsc_envs.orbit_attitude.controller.eso_input`), so Δd
+    is exactly the extended state Z2 the ESO estimates.
     """
     true_rate = relative_derivative(t, y, (wrench, model))[7:13]
-    return true_rate - known - inertia_solve(eso_input(held, gains), gains)
+    return true_rate - known - inertia_solve(fed, gains)
 
 
 @jit
@@ -191,6 +198,7 @@ def closed_loop_step(
     y: np.ndarray,
     c: np.ndarray,
     held: np.ndarray,
+    response: tuple,
     model: PlantModel,
     gains: ControllerGains,
     view: np.ndarray,
@@ -199,19 +207,20 @@ def closed_loop_step(
 ):
     """Advance plant and controller from t to t + h with the held command ``held``.
 
-    ``view = [S(t), H1(t)]`` is what the controller evaluated at t (returned by the previous
-    step, or :func:`initial_view`). Returns ``(y_next, c_next, fresh_command, features,
-    view_next, cost, diagnostics, thruster_output)``: the states at t + h, the command a
-    transmission at t + h would send, the observation features and ``[S, H1]`` there, the
-    step's :func:`tracking_cost` at t + h, the :data:`N_DIAGNOSTICS` summary (its maxima of the
-    ESO errors ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at t + h, Δd with the command held over the
-    period just simulated, are computed only if ``with_disturbance``, else zero), and the
-    thruster outputs u_a over the period (N).
+    ``response = (u_a, Γ_actual, fed)`` is what the thrusters and the ESO make of ``held``
+    (:func:`held_response`). ``view = [S(t), H1(t)]`` is what the controller evaluated at t
+    (returned by the previous step, or :func:`initial_view`). Returns ``(y_next, c_next,
+    fresh_command, features, view_next, cost, diagnostics)``: the states at t + h, the command
+    a transmission at t + h would send, the observation features and ``[S, H1]`` there, the
+    step's :func:`tracking_cost` at t + h, and the :data:`N_DIAGNOSTICS` summary (its maxima of
+    the ESO errors ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at t + h, Δd with the command held over
+    the period just simulated, are computed only if ``with_disturbance``, else zero).
     """
     # controller at t: ESO, adaptive law and the integral of eq. (23), forward Euler
     surface = view[0:6]
     drift = view[6:12]
-    dz1, dz2 = eso_derivative(c[0:6], c[6:12], surface, drift, eso_input(held, gains), gains)
+    output, wrench, fed = response
+    dz1, dz2 = eso_derivative(c[0:6], c[6:12], surface, drift, fed, gains)
     c_next = c.copy()
     c_next[0:6] += h * dz1
     c_next[6:12] += h * dz2
@@ -219,7 +228,6 @@ def closed_loop_step(
     c_next[14:16] += h * c[12:14]
 
     # plant over [t, t + h) under the held command (ZOH at the thrusters)
-    _, output, wrench = thruster_outputs(held, model)
     y_next = y
     dt = h / substeps
     for i in range(substeps):
@@ -236,7 +244,7 @@ def closed_loop_step(
     e1 = c_next[0:6] - surface
     e2 = np.zeros(6)
     if with_disturbance:
-        e2 = c_next[6:12] - total_disturbance(t_next, y_next, wrench, held, known, model, gains)
+        e2 = c_next[6:12] - total_disturbance(t_next, y_next, wrench, fed, known, model, gains)
     twist_error = y_next[7:13]
     cost = tracking_cost(eta, twist_error, cost_reference)
     e2_physical = inertia_times(e2, gains)
@@ -255,7 +263,7 @@ def closed_loop_step(
     diagnostics[11] = np.sqrt(fused_dot(twist_error[0:3], twist_error[0:3]))
     diagnostics[12] = np.sqrt(fused_dot(twist_error[3:6], twist_error[3:6]))
     diagnostics[13] = 1.0 if np.isfinite(y_next).all() and np.isfinite(features).all() else 0.0
-    return y_next, c_next, fresh, features, view_next, cost, diagnostics, output
+    return y_next, c_next, fresh, features, view_next, cost, diagnostics
 
 
 @jit
@@ -368,6 +376,32 @@ def channel_values(state: np.ndarray, constants: LoopConstants, time_s: float) -
 
 
 @jit
+def hold_command(
+    state: np.ndarray, command: np.ndarray, model: PlantModel, gains: ControllerGains
+) -> None:
+    """Store in the state row what the thrusters (eqs. 10-12: u_a, Γ_actual) and the ESO's
+    model (:func:`~etsc_envs.orbit_attitude.controller.eso_input`) make of the held ``command``.
+
+    They depend on nothing else, so they are computed once per transmission, not every step.
+    """
+    _, state[THRUSTER_OUTPUT], state[HELD_WRENCH] = thruster_outputs(command, model)
+    state[HELD_FED] = eso_input(command, gains)
+    state[HELD_COMMAND] = command
+
+
+@jit
+def held_response(state: np.ndarray, held: np.ndarray, model: PlantModel, gains: ControllerGains):
+    """``(u_a, Γ_actual, fed)`` of the held command (:func:`hold_command`), recomputed only
+    when ``held`` is not the command the state row's values were made of."""
+    stored = state[HELD_COMMAND]
+    for i in range(stored.size):
+        if held[i] != stored[i]:
+            hold_command(state, held, model, gains)
+            break
+    return state[THRUSTER_OUTPUT], state[HELD_WRENCH], state[HELD_FED]
+
+
+@jit
 def advance_loop(
     state: np.ndarray,
     constants: LoopConstants,
@@ -381,6 +415,8 @@ def advance_loop(
     if sent[0] != 0:  # a transmission at t_k restarts ∫_{t_k} ϕ̂ ds of eq. (23)
         state[CONTROLLER][INTEGRAL] = 0.0
     steady = step_index + 1 > constants.steady_start
+    model = episode_model(state, constants)
+    gains = episode_gains(state, constants)
     (
         state[PLANT],
         state[CONTROLLER],
@@ -389,7 +425,6 @@ def advance_loop(
         state[VIEW],
         channel_costs[0],
         state[DIAGNOSTICS],
-        state[THRUSTER_OUTPUT],
     ) = closed_loop_step(
         step_index * h,
         h,
@@ -397,8 +432,9 @@ def advance_loop(
         state[PLANT],
         state[CONTROLLER],
         held[0],
-        episode_model(state, constants),
-        episode_gains(state, constants),
+        held_response(state, held[0], model, gains),
+        model,
+        gains,
         state[VIEW],
         constants.cost_reference,
         steady,

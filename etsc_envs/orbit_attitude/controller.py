@@ -28,6 +28,7 @@ from etsc_envs.core.linalg import (
     fused_matmul,
     fused_matvec3,
     fused_matvec3_transposed,
+    fused_matvec6,
 )
 from etsc_envs.core.rotations import (
     cross,
@@ -138,7 +139,7 @@ def known_dynamics(
     rotation_a = np.ascontiguousarray(g_a[:3, :3])
     position = np.ascontiguousarray(g_a[:3, 3])
     desired = leader_twist(leader)
-    desired_in_body = se3_adjoint(se3_inverse(g_e)) @ desired  # Ad_{g_e⁻¹} V_d
+    desired_in_body = fused_matvec6(se3_adjoint(se3_inverse(g_e)), desired)  # Ad_{g_e⁻¹} V_d
     twist = twist_error + desired_in_body
     omega = np.ascontiguousarray(twist[0:3])
     velocity = np.ascontiguousarray(twist[3:6])
@@ -149,7 +150,7 @@ def known_dynamics(
     out[0:3] = fused_matvec3(gains.inertia_inv, -cross(omega, fused_matvec3(gains.inertia, omega)))
     out[3:6] = -cross(omega, velocity)
     # + ad_Ṽ Ad_{g_e⁻¹} V_d  (V̇_d = 0 on the circular orbit)
-    out += se3_ad(twist_error) @ desired_in_body
+    out += fused_matvec6(se3_ad(twist_error), desired_in_body)
     # + Ξ⁻¹ f(Ξ): gravity-gradient moment and gravity force with J2, nominal J and m
     position_body = fused_matvec3_transposed(rotation_a, position)
     out[0:3] += fused_matvec3(
@@ -179,7 +180,7 @@ def surface_drift(
     ``known`` is :func:`known_dynamics`. The factor ``|η̃_i|^(α-1)`` is singular where a
     component of η̃ crosses zero; |η̃_i| is floored at ``gains.singularity_floor``.
     """
-    eta_rate = se3_right_jacobian_inverse(eta) @ twist_error  # η̃̇ = G(η̃) Ṽ, eq. (7)
+    eta_rate = fused_matvec6(se3_right_jacobian_inverse(eta), twist_error)  # η̃̇ = G(η̃)Ṽ, eq. 7
     magnitude = np.maximum(np.abs(eta), gains.singularity_floor)
     return (
         known
@@ -237,13 +238,18 @@ def eso_derivative(
 
 
 @jit
+def adaptive_denominator(surface: np.ndarray, t: float, gains: ControllerGains) -> np.ndarray:
+    """``‖S̄_j‖ + ϵ_j exp(-σ_j t)``, j = 1, 2: the denominator of K3 in eq. (23)."""
+    return block_norms(surface) + gains.epsilon * np.exp(-gains.sigma * t)
+
+
+@jit
 def adaptive_gain(
-    phi_hat: np.ndarray, integral: np.ndarray, surface: np.ndarray, t: float, gains: ControllerGains
+    phi_hat: np.ndarray, integral: np.ndarray, denominator: np.ndarray, gains: ControllerGains
 ) -> np.ndarray:
-    """``K3j = (ϕ̂_j + ℓ_j ∫_{t_k}^t ϕ̂_j ds) / (‖S̄_j‖ + ϵ_j exp(-σ_j t))`` (eq. 23), j = 1, 2."""
-    return (phi_hat + gains.ell * integral) / (
-        block_norms(surface) + gains.epsilon * np.exp(-gains.sigma * t)
-    )
+    """``K3j = (ϕ̂_j + ℓ_j ∫_{t_k}^t ϕ̂_j ds) / (‖S̄_j‖ + ϵ_j exp(-σ_j t))`` (eq. 23), j = 1, 2,
+    with the denominator of :func:`adaptive_denominator`."""
+    return (phi_hat + gains.ell * integral) / denominator
 
 
 @jit
