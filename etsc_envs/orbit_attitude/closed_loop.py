@@ -30,6 +30,7 @@ from etsc_envs.orbit_attitude.controller import (
     adaptive_denominator,
     adaptive_derivative,
     adaptive_gain,
+    block_norms,
     control_law,
     eso_derivative,
     eso_input,
@@ -120,7 +121,7 @@ def controller_view(t: float, y: np.ndarray, c: np.ndarray, gains: ControllerGai
     z2 = c[6:12]
     phi_hat = c[12:14]
     fixed_gain = fixed_gain_feedback(drift, z2, surface, gains)
-    denominator = adaptive_denominator(surface, t, gains)
+    denominator = adaptive_denominator(block_norms(surface), t, gains)
     integral = c[14:16]
     command = control_law(fixed_gain, surface, adaptive_gain(phi_hat, integral, denominator, gains))
     restarted = adaptive_gain(phi_hat, np.zeros(2), denominator, gains)
@@ -181,6 +182,30 @@ def disturbance_step(
 
 
 @jit
+def abs_max(x: np.ndarray) -> float:
+    """``np.abs(x).max()`` without the temporary: the largest |x_i|, or the first NaN."""
+    largest = np.abs(x[0])
+    for i in range(x.size):
+        value = np.abs(x[i])
+        if np.isnan(value):
+            return value
+        if value > largest:
+            largest = value
+    return largest
+
+
+@jit
+def all_finite(x: np.ndarray) -> bool:
+    """``np.isfinite(x).all()`` without the temporary."""
+    finite = True
+    for i in range(x.size):
+        if not np.isfinite(x[i]):
+            finite = False
+            break
+    return finite
+
+
+@jit
 def tracking_cost(eta: np.ndarray, twist_error: np.ndarray, reference: np.ndarray) -> float:
     """Per-step accuracy cost ``¼ Σ_j log(1 + ‖x_j‖ / ref_j)`` for x = Φ, Δω, χ, Δv."""
     cost = np.log1p(np.sqrt(fused_dot(eta[0:3], eta[0:3])) / reference[0])
@@ -221,11 +246,14 @@ def closed_loop_step(
     drift = view[6:12]
     output, wrench, fed = response
     dz1, dz2 = eso_derivative(c[0:6], c[6:12], surface, drift, fed, gains)
-    c_next = c.copy()
-    c_next[0:6] += h * dz1
-    c_next[6:12] += h * dz2
-    c_next[12:14] += h * adaptive_derivative(c[12:14], surface, t, gains)
-    c_next[14:16] += h * c[12:14]
+    dphi = adaptive_derivative(c[12:14], surface, t, gains)
+    c_next = np.empty(16)
+    for i in range(6):
+        c_next[i] = c[i] + h * dz1[i]
+        c_next[6 + i] = c[6 + i] + h * dz2[i]
+    for j in range(2):
+        c_next[12 + j] = c[12 + j] + h * dphi[j]
+        c_next[14 + j] = c[14 + j] + h * c[12 + j]
 
     # plant over [t, t + h) under the held command (ZOH at the thrusters)
     y_next = y
@@ -241,28 +269,34 @@ def closed_loop_step(
     view_next = np.empty(12)
     view_next[0:6] = surface
     view_next[6:12] = drift
-    e1 = c_next[0:6] - surface
-    e2 = np.zeros(6)
-    if with_disturbance:
-        e2 = c_next[6:12] - total_disturbance(t_next, y_next, wrench, fed, known, model, gains)
+    e1 = np.empty(6)
+    for i in range(6):
+        e1[i] = c_next[i] - surface[i]
     twist_error = y_next[7:13]
     cost = tracking_cost(eta, twist_error, cost_reference)
-    e2_physical = inertia_times(e2, gains)
     diagnostics = np.empty(N_DIAGNOSTICS)
     diagnostics[0] = np.sqrt(fused_dot(eta[0:3], eta[0:3]))
     diagnostics[1] = np.sqrt(fused_dot(eta[3:6], eta[3:6]))
-    diagnostics[2] = np.abs(eta[0:3]).max()
-    diagnostics[3] = np.abs(twist_error[0:3]).max()
-    diagnostics[4] = np.abs(eta[3:6]).max()
-    diagnostics[5] = np.abs(twist_error[3:6]).max()
-    diagnostics[6] = np.abs(e1[0:3]).max()
-    diagnostics[7] = np.abs(e1[3:6]).max()
-    diagnostics[8] = np.abs(e2_physical[0:3]).max()
-    diagnostics[9] = np.abs(e2_physical[3:6]).max()
-    diagnostics[10] = h * np.abs(output).sum()
+    diagnostics[2] = abs_max(eta[0:3])
+    diagnostics[3] = abs_max(twist_error[0:3])
+    diagnostics[4] = abs_max(eta[3:6])
+    diagnostics[5] = abs_max(twist_error[3:6])
+    diagnostics[6] = abs_max(e1[0:3])
+    diagnostics[7] = abs_max(e1[3:6])
+    diagnostics[8] = 0.0
+    diagnostics[9] = 0.0
+    if with_disturbance:
+        e2 = c_next[6:12] - total_disturbance(t_next, y_next, wrench, fed, known, model, gains)
+        e2_physical = inertia_times(e2, gains)
+        diagnostics[8] = abs_max(e2_physical[0:3])
+        diagnostics[9] = abs_max(e2_physical[3:6])
+    total_output = 0.0
+    for i in range(output.size):
+        total_output += np.abs(output[i])
+    diagnostics[10] = h * total_output
     diagnostics[11] = np.sqrt(fused_dot(twist_error[0:3], twist_error[0:3]))
     diagnostics[12] = np.sqrt(fused_dot(twist_error[3:6], twist_error[3:6]))
-    diagnostics[13] = 1.0 if np.isfinite(y_next).all() and np.isfinite(features).all() else 0.0
+    diagnostics[13] = 1.0 if all_finite(y_next) and all_finite(features) else 0.0
     return y_next, c_next, fresh, features, view_next, cost, diagnostics
 
 

@@ -81,9 +81,18 @@ ControllerGains = namedtuple(
 
 
 @jit
-def sig(x: np.ndarray, power: float) -> np.ndarray:
-    """``sig^a(x) = |x|^a sign(x)`` elementwise."""
+def signed_power(x: float, power: float) -> float:
+    """``sig^a(x) = |x|^a sign(x)`` of a scalar."""
     return np.sign(x) * np.abs(x) ** power
+
+
+@jit
+def sig(x: np.ndarray, power: float) -> np.ndarray:
+    """``sig^a(x) = |x|^a sign(x)`` elementwise (:func:`signed_power`)."""
+    out = np.empty(x.size)
+    for i in range(x.size):
+        out[i] = signed_power(x[i], power)
+    return out
 
 
 @jit
@@ -92,15 +101,6 @@ def block_norms(x: np.ndarray) -> np.ndarray:
     out = np.empty(2)
     out[0] = np.sqrt(fused_dot(x[0:3], x[0:3]))
     out[1] = np.sqrt(fused_dot(x[3:6], x[3:6]))
-    return out
-
-
-@jit
-def scale_blocks(x: np.ndarray, pair: np.ndarray) -> np.ndarray:
-    """``diag(pair[0] I3, pair[1] I3) x``."""
-    out = x.copy()
-    out[0:3] *= pair[0]
-    out[3:6] *= pair[1]
     return out
 
 
@@ -168,7 +168,14 @@ def known_dynamics(
 @jit
 def sliding_surface(eta: np.ndarray, twist_error: np.ndarray, gains: ControllerGains):
     """FTSM ``S = Ṽ + ϑ1 η̃ + ϑ2 sig^α(η̃)`` (section III-B)."""
-    return twist_error + gains.theta1 * eta + gains.theta2 * sig(eta, gains.alpha)
+    out = np.empty(6)
+    for i in range(6):
+        out[i] = (
+            twist_error[i]
+            + gains.theta1[i] * eta[i]
+            + gains.theta2[i] * signed_power(eta[i], gains.alpha)
+        )
+    return out
 
 
 @jit
@@ -181,12 +188,15 @@ def surface_drift(
     component of η̃ crosses zero; |η̃_i| is floored at ``gains.singularity_floor``.
     """
     eta_rate = fused_matvec6(se3_right_jacobian_inverse(eta), twist_error)  # η̃̇ = G(η̃)Ṽ, eq. 7
-    magnitude = np.maximum(np.abs(eta), gains.singularity_floor)
-    return (
-        known
-        + gains.theta1 * eta_rate
-        + gains.alpha * gains.theta2 * magnitude ** (gains.alpha - 1.0) * eta_rate
-    )
+    out = np.empty(6)
+    for i in range(6):
+        magnitude = np.maximum(np.abs(eta[i]), gains.singularity_floor)
+        out[i] = (
+            known[i]
+            + gains.theta1[i] * eta_rate[i]
+            + gains.alpha * gains.theta2[i] * magnitude ** (gains.alpha - 1.0) * eta_rate[i]
+        )
+    return out
 
 
 @jit
@@ -220,27 +230,30 @@ def eso_derivative(
     Returns ``(dẐ1/dt, dẐ2/dt)``.
     """
     beta, a1, a2 = gains.beta, gains.alpha1, gains.alpha2
-    e1 = z1 - surface
-    sig1 = sig(e1, a1)
-    dz1 = (
-        drift
-        + inertia_solve(command, gains)
-        + z2
-        - gains.k1 * beta**a1 * sig1
-        - gains.k2 * beta * e1
-    )
-    dz2 = (
-        -gains.k3 * beta ** (2.0 * a1) * sig(e1, a2)
-        - gains.k4 * beta ** (a1 + 1.0) * sig1
-        - gains.k5 * beta * beta * e1
-    )
+    beta_a1, beta_2a1, beta_a1_1 = beta**a1, beta ** (2.0 * a1), beta ** (a1 + 1.0)
+    fed = inertia_solve(command, gains)
+    dz1 = np.empty(6)
+    dz2 = np.empty(6)
+    for i in range(6):
+        e1 = z1[i] - surface[i]
+        sig1 = signed_power(e1, a1)
+        dz1[i] = drift[i] + fed[i] + z2[i] - gains.k1[i] * beta_a1 * sig1 - gains.k2[i] * beta * e1
+        dz2[i] = (
+            -gains.k3[i] * beta_2a1 * signed_power(e1, a2)
+            - gains.k4[i] * beta_a1_1 * sig1
+            - gains.k5[i] * beta * beta * e1
+        )
     return dz1, dz2
 
 
 @jit
-def adaptive_denominator(surface: np.ndarray, t: float, gains: ControllerGains) -> np.ndarray:
-    """``‖S̄_j‖ + ϵ_j exp(-σ_j t)``, j = 1, 2: the denominator of K3 in eq. (23)."""
-    return block_norms(surface) + gains.epsilon * np.exp(-gains.sigma * t)
+def adaptive_denominator(norms: np.ndarray, t: float, gains: ControllerGains) -> np.ndarray:
+    """``‖S̄_j‖ + ϵ_j exp(-σ_j t)``, j = 1, 2, from ``norms = ‖S̄_j‖`` (:func:`block_norms`):
+    the denominator of K3 in eq. (23) and of eq. (24)."""
+    out = np.empty(2)
+    for j in range(2):
+        out[j] = norms[j] + gains.epsilon[j] * np.exp(-gains.sigma[j] * t)
+    return out
 
 
 @jit
@@ -258,7 +271,11 @@ def adaptive_derivative(
 ) -> np.ndarray:
     """``ϕ̂_j' = -ℓ_j ϕ̂_j + ‖S̄_j‖² / (‖S̄_j‖ + ϵ_j exp(-σ_j t))`` (eq. 24)."""
     norms = block_norms(surface)
-    return -gains.ell * phi_hat + norms * norms / (norms + gains.epsilon * np.exp(-gains.sigma * t))
+    denominator = adaptive_denominator(norms, t, gains)
+    out = np.empty(2)
+    for j in range(2):
+        out[j] = -gains.ell[j] * phi_hat[j] + norms[j] * norms[j] / denominator[j]
+    return out
 
 
 @jit
@@ -266,18 +283,27 @@ def fixed_gain_feedback(
     drift: np.ndarray, z2: np.ndarray, surface: np.ndarray, gains: ControllerGains
 ) -> np.ndarray:
     """``-Ξ(H1 + Ẑ2) - K1 sig^α(S) - K2 S``: the part of eq. (22) without the adaptive K3."""
-    return (
-        -inertia_times(drift + z2, gains)
-        - gains.gain_k1 * sig(surface, gains.alpha)
-        - gains.gain_k2 * surface
-    )
+    total = np.empty(6)
+    for i in range(6):
+        total[i] = drift[i] + z2[i]
+    out = inertia_times(total, gains)
+    for i in range(6):
+        out[i] = (
+            -out[i]
+            - gains.gain_k1[i] * signed_power(surface[i], gains.alpha)
+            - gains.gain_k2[i] * surface[i]
+        )
+    return out
 
 
 @jit
 def control_law(fixed_gain: np.ndarray, surface: np.ndarray, k3: np.ndarray) -> np.ndarray:
     """``Γ_cout = -Ξ(H1 + Ẑ2) - K1 sig^α(S) - (K2 + K3) S`` (eq. 22): [τ (N·m), u (N)], from
     :func:`fixed_gain_feedback` and the adaptive gains K3 = [K31, K32]."""
-    return fixed_gain - scale_blocks(surface, k3)
+    out = np.empty(6)
+    for i in range(6):
+        out[i] = fixed_gain[i] - surface[i] * k3[i // 3]
+    return out
 
 
 @jit

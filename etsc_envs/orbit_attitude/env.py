@@ -58,6 +58,7 @@ from etsc_envs.orbit_attitude.controller import (
     ControllerGains,
     adaptive_denominator,
     adaptive_gain,
+    block_norms,
     eso_input,
 )
 from etsc_envs.orbit_attitude.dynamics import (
@@ -433,6 +434,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         eta, surface, _, known, command, fresh = controller_view(t, y, c, gains)
         held = self.held[0].copy()
         wrench = thruster_outputs(held, model)[2]
+        denominator = adaptive_denominator(block_norms(surface), t, gains)
         disturbance = total_disturbance(t, y, wrench, eso_input(held, gains), known, model, gains)
         return {
             "time_s": np.array(t),
@@ -445,7 +447,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             "e1": c[0:6] - surface,
             "e2": c[6:12] - disturbance,
             "phi_hat": c[12:14].copy(),
-            "k3": adaptive_gain(c[12:14], c[14:16], adaptive_denominator(surface, t, gains), gains),
+            "k3": adaptive_gain(c[12:14], c[14:16], denominator, gains),
             "command": command,
             "fresh_command": fresh,
             "held_command": held,
