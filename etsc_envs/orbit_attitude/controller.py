@@ -27,11 +27,9 @@ from etsc_envs.core.linalg import (
     fused_dot,
     fused_matmul,
     fused_matvec3,
-    fused_matvec3_transposed,
     fused_matvec6,
 )
 from etsc_envs.core.rotations import (
-    cross,
     se3_ad,
     se3_adjoint,
     se3_inverse,
@@ -144,24 +142,29 @@ def known_dynamics(
     omega = np.ascontiguousarray(twist[0:3])
     velocity = np.ascontiguousarray(twist[3:6])
 
-    out = np.empty(6)
     # Ξ⁻¹ ad*_V Ξ V = [J⁻¹(-ω × Jω - v × m v), -ω × v]; v × m v = 0 is dropped exactly rather
     # than left to rounding (~1e-6 N·m at orbital speed).
-    out[0:3] = fused_matvec3(gains.inertia_inv, -cross(omega, fused_matvec3(gains.inertia, omega)))
-    out[3:6] = -cross(omega, velocity)
+    inertia_inv = gains.inertia_inv
+    free_rate = vec3.matvec(
+        inertia_inv, vec3.negate(vec3.cross(omega, vec3.matvec(gains.inertia, omega)))
+    )
+    free_acceleration = vec3.negate(vec3.cross(omega, velocity))
     # + ad_Ṽ Ad_{g_e⁻¹} V_d  (V̇_d = 0 on the circular orbit)
-    out += fused_matvec6(se3_ad(twist_error), desired_in_body)
+    out = fused_matvec6(se3_ad(twist_error), desired_in_body)
     # + Ξ⁻¹ f(Ξ): gravity-gradient moment and gravity force with J2, nominal J and m
-    position_body = fused_matvec3_transposed(rotation_a, position)
-    out[0:3] += fused_matvec3(
-        gains.inertia_inv, gravity_gradient_torque(position_body, gains.inertia, leader.mu)
+    position_body = vec3.matvec_transposed(rotation_a, position)
+    gradient_rate = vec3.matvec(
+        inertia_inv, gravity_gradient_torque(position_body, gains.inertia, leader.mu)
     )
     acceleration = kepler_gravity(position, leader.mu)
     if gains.j2 != 0.0:
         acceleration = vec3.add(
             acceleration, j2_acceleration(position, leader.mu, gains.earth_radius, gains.j2)
         )
-    out[3:6] += fused_matvec3_transposed(rotation_a, acceleration)
+    gravity_body = vec3.matvec_transposed(rotation_a, acceleration)
+    for i in range(3):
+        out[i] = (free_rate[i] + out[i]) + gradient_rate[i]
+        out[3 + i] = (free_acceleration[i] + out[3 + i]) + gravity_body[i]
     return out
 
 
