@@ -233,7 +233,7 @@ def closed_loop_step(
     """Advance plant and controller from t to t + h with the held command ``held``.
 
     ``response = (u_a, Γ_actual, fed)`` is what the thrusters and the ESO make of ``held``
-    (:func:`held_response`). ``view = [S(t), H1(t)]`` is what the controller evaluated at t
+    (:func:`hold_command`). ``view = [S(t), H1(t)]`` is what the controller evaluated at t
     (returned by the previous step, or :func:`initial_view`). Returns ``(y_next, c_next,
     fresh_command, features, view_next, cost, diagnostics)``: the states at t + h, the command
     a transmission at t + h would send, the observation features and ``[S, H1]`` there, the
@@ -424,15 +424,15 @@ def hold_command(
 
 
 @jit
-def held_response(state: np.ndarray, held: np.ndarray, model: PlantModel, gains: ControllerGains):
-    """``(u_a, Γ_actual, fed)`` of the held command (:func:`hold_command`), recomputed only
-    when ``held`` is not the command the state row's values were made of."""
+def holds(state: np.ndarray, command: np.ndarray) -> bool:
+    """Whether the state row's :func:`hold_command` values were made of ``command``."""
     stored = state[HELD_COMMAND]
+    same = True
     for i in range(stored.size):
-        if held[i] != stored[i]:
-            hold_command(state, held, model, gains)
+        if command[i] != stored[i]:
+            same = False
             break
-    return state[THRUSTER_OUTPUT], state[HELD_WRENCH], state[HELD_FED]
+    return same
 
 
 @jit
@@ -451,6 +451,8 @@ def advance_loop(
     steady = step_index + 1 > constants.steady_start
     model = episode_model(state, constants)
     gains = episode_gains(state, constants)
+    if not holds(state, held[0]):
+        hold_command(state, held[0], model, gains)
     (
         state[PLANT],
         state[CONTROLLER],
@@ -466,7 +468,7 @@ def advance_loop(
         state[PLANT],
         state[CONTROLLER],
         held[0],
-        held_response(state, held[0], model, gains),
+        (state[THRUSTER_OUTPUT], state[HELD_WRENCH], state[HELD_FED]),
         model,
         gains,
         state[VIEW],
