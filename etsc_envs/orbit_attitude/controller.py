@@ -171,13 +171,10 @@ def known_dynamics(
 @jit
 def sliding_surface(eta: np.ndarray, twist_error: np.ndarray, gains: ControllerGains):
     """FTSM ``S = Ṽ + ϑ1 η̃ + ϑ2 sig^α(η̃)`` (section III-B)."""
+    theta1, theta2, alpha = gains.theta1, gains.theta2, gains.alpha
     out = np.empty(6)
     for i in range(6):
-        out[i] = (
-            twist_error[i]
-            + gains.theta1[i] * eta[i]
-            + gains.theta2[i] * signed_power(eta[i], gains.alpha)
-        )
+        out[i] = twist_error[i] + theta1[i] * eta[i] + theta2[i] * signed_power(eta[i], alpha)
     return out
 
 
@@ -191,13 +188,15 @@ def surface_drift(
     component of η̃ crosses zero; |η̃_i| is floored at ``gains.singularity_floor``.
     """
     eta_rate = fused_matvec6(se3_right_jacobian_inverse(eta), twist_error)  # η̃̇ = G(η̃)Ṽ, eq. 7
+    theta1, theta2, alpha = gains.theta1, gains.theta2, gains.alpha
+    floor = gains.singularity_floor
     out = np.empty(6)
     for i in range(6):
-        magnitude = np.maximum(np.abs(eta[i]), gains.singularity_floor)
+        magnitude = np.maximum(np.abs(eta[i]), floor)
         out[i] = (
             known[i]
-            + gains.theta1[i] * eta_rate[i]
-            + gains.alpha * gains.theta2[i] * magnitude ** (gains.alpha - 1.0) * eta_rate[i]
+            + theta1[i] * eta_rate[i]
+            + alpha * theta2[i] * magnitude ** (alpha - 1.0) * eta_rate[i]
         )
     return out
 
@@ -234,17 +233,18 @@ def eso_derivative(
     """
     beta, a1, a2 = gains.beta, gains.alpha1, gains.alpha2
     beta_a1, beta_2a1, beta_a1_1 = beta**a1, beta ** (2.0 * a1), beta ** (a1 + 1.0)
+    k1, k2, k3, k4, k5 = gains.k1, gains.k2, gains.k3, gains.k4, gains.k5
     fed = inertia_solve(command, gains)
     dz1 = np.empty(6)
     dz2 = np.empty(6)
     for i in range(6):
         e1 = z1[i] - surface[i]
         sig1 = signed_power(e1, a1)
-        dz1[i] = drift[i] + fed[i] + z2[i] - gains.k1[i] * beta_a1 * sig1 - gains.k2[i] * beta * e1
+        dz1[i] = drift[i] + fed[i] + z2[i] - k1[i] * beta_a1 * sig1 - k2[i] * beta * e1
         dz2[i] = (
-            -gains.k3[i] * beta_2a1 * signed_power(e1, a2)
-            - gains.k4[i] * beta_a1_1 * sig1
-            - gains.k5[i] * beta * beta * e1
+            -k3[i] * beta_2a1 * signed_power(e1, a2)
+            - k4[i] * beta_a1_1 * sig1
+            - k5[i] * beta * beta * e1
         )
     return dz1, dz2
 
@@ -290,12 +290,9 @@ def fixed_gain_feedback(
     for i in range(6):
         total[i] = drift[i] + z2[i]
     out = inertia_times(total, gains)
+    gain_k1, gain_k2, alpha = gains.gain_k1, gains.gain_k2, gains.alpha
     for i in range(6):
-        out[i] = (
-            -out[i]
-            - gains.gain_k1[i] * signed_power(surface[i], gains.alpha)
-            - gains.gain_k2[i] * surface[i]
-        )
+        out[i] = -out[i] - gain_k1[i] * signed_power(surface[i], alpha) - gain_k2[i] * surface[i]
     return out
 
 
