@@ -16,6 +16,7 @@ from etsc_envs.core.linalg import (
     fused_matmul,
     fused_matvec3,
     fused_matvec3_transposed,
+    fused_matvec6,
     fused_multiply_add,
     matmul,
     matvec,
@@ -126,6 +127,16 @@ def test_fused_products_match_compiled_blas_to_its_rounding():
                 _compiled_blas_matmul(left, right),
                 np.abs(left) @ np.abs(right),
                 size,
+            )
+    for rows in (6, 12):
+        for _ in range(500):
+            matrix = rng.normal(size=(rows, 6)) * 10.0 ** rng.uniform(-8, 6, size=(rows, 1))
+            vector = rng.normal(size=6)
+            assert _within_rounding(
+                fused_matvec6(matrix, vector),
+                _compiled_blas_matvec(matrix, vector),
+                np.abs(matrix) @ np.abs(vector),
+                6,
             )
 
 

@@ -38,7 +38,7 @@ from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import se3_exp, se3_log
 from etsc_envs.orbit_attitude.closed_loop import integrate_plant
-from etsc_envs.orbit_attitude.controller import known_dynamics
+from etsc_envs.orbit_attitude.controller import eso_input, known_dynamics
 from etsc_envs.orbit_attitude.dynamics import (
     PlantModel,
     chaser_pose_and_twist,
@@ -452,7 +452,7 @@ def test_total_disturbance_is_the_surface_rate_not_explained_by_the_model():
     s_plus = surface_at(h)[1]
     s_minus = surface_at(-h)[1]
     surface_rate = (s_plus - s_minus) / (2 * h)
-    from etsc_envs.orbit_attitude.controller import eso_input, inertia_solve
+    from etsc_envs.orbit_attitude.controller import inertia_solve
 
     expected = (
         surface_rate - drift - inertia_solve(eso_input(held, unwrapped.gains), unwrapped.gains)
@@ -478,7 +478,8 @@ def test_disturbance_step_is_the_jump_of_the_total_disturbance_at_a_transmission
 
         def disturbance(command, model=model, gains=gains, t=t, y=y):
             wrench = thruster_outputs(command, model)[2]
-            return total_disturbance(t, y, wrench, command, np.zeros(6), model, gains)
+            fed = eso_input(command, gains)
+            return total_disturbance(t, y, wrench, fed, np.zeros(6), model, gains)
 
         for before, after in ((held, 0.5 * held), (small_before, small_after)):
             jump = disturbance(after) - disturbance(before)

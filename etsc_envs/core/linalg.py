@@ -130,6 +130,29 @@ def fused_matvec3_transposed(matrix: np.ndarray, vector) -> np.ndarray:
 
 
 @jit
+def fused_row_dot6(matrix: np.ndarray, row: int, vector: np.ndarray) -> float:
+    """Entry ``row`` of ``matrix @ vector`` for a C-ordered matrix of 6 columns, as
+    ``((m_0 v_0 + m_2 v_2) + (m_1 v_1 + m_3 v_3)) + fma(m_4, v_4, m_5 v_5)``: OpenBLAS's
+    ``dgemv`` on the transposed view sums the first four products in vector lanes and adds the
+    last two separately, and returns this value bit for bit."""
+    lanes = (matrix[row, 0] * vector[0] + matrix[row, 2] * vector[2]) + (
+        matrix[row, 1] * vector[1] + matrix[row, 3] * vector[3]
+    )
+    return lanes + fused_multiply_add(matrix[row, 4], vector[4], matrix[row, 5] * vector[5])
+
+
+@jit
+def fused_matvec6(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
+    """``matrix @ vector`` for a C-ordered matrix of 6 columns (any rows) by
+    :func:`fused_row_dot6`: the same value, bit for bit, as the OpenBLAS ``dgemv`` NumPy's ``@``
+    calls, without the call's overhead."""
+    out = np.empty(matrix.shape[0])
+    for i in range(matrix.shape[0]):
+        out[i] = fused_row_dot6(matrix, i, vector)
+    return out
+
+
+@jit
 def fused_matmul(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     """``left @ right``, each entry the chain ``fma(l_in r_nj, ... fma(l_i1 r_1j, l_i0 r_0j))``:
     the same value, bit for bit, as the OpenBLAS ``dgemm`` NumPy's ``@`` calls for the square

@@ -363,7 +363,11 @@ def so3_right_jacobian_inverse(phi: np.ndarray) -> np.ndarray:
         coefficient = 1.0 / 12.0 + a2 / 720.0 + a2 * a2 / 30240.0 + a2 * a2 * a2 / 1209600.0
     else:
         coefficient = 1.0 / angle**2 - (1.0 + np.cos(angle)) / (2.0 * angle * np.sin(angle))
-    return np.eye(3) + 0.5 * phi_x + fused_matmul(coefficient * phi_x, phi_x)
+    out = fused_matmul(coefficient * phi_x, phi_x)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = ((1.0 if i == j else 0.0) + 0.5 * phi_x[i, j]) + out[i, j]
+    return out
 
 
 @jit
@@ -391,12 +395,19 @@ def se3_left_jacobian_coupling(phi: np.ndarray, rho: np.ndarray) -> np.ndarray:
     prp = fused_matmul(pr, p)
     pp = fused_matmul(p, p)
     ppr = fused_matmul(pp, r)
-    return (
-        0.5 * r
-        + c1 * (pr + rp + prp)
-        + c2 * (ppr + fused_matmul(rp, p) - 3.0 * prp)
-        + c3 * (fused_matmul(prp, p) + fused_matmul(ppr, p))
-    )
+    rpp = fused_matmul(rp, p)
+    prpp = fused_matmul(prp, p)
+    pprp = fused_matmul(ppr, p)
+    out = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = (
+                0.5 * r[i, j]
+                + c1 * (pr[i, j] + rp[i, j] + prp[i, j])
+                + c2 * (ppr[i, j] + rpp[i, j] - 3.0 * prp[i, j])
+                + c3 * (prpp[i, j] + pprp[i, j])
+            )
+    return out
 
 
 @jit

@@ -27,8 +27,10 @@ from etsc_envs.core.linalg import fused_dot
 from etsc_envs.core.rotations import se3_log
 from etsc_envs.orbit_attitude.controller import (
     ControllerGains,
+    adaptive_denominator,
     adaptive_derivative,
     adaptive_gain,
+    block_norms,
     control_law,
     eso_derivative,
     eso_input,
@@ -70,7 +72,10 @@ TORQUE_PHASE = slice(112, 115)  # phases of d_τ
 FORCE_PHASE = slice(115, 118)  # phases of d_f
 MISALIGNMENT = slice(118, 190)  # ΔD, 6×12 row-major
 TRUE_DISTRIBUTION = slice(190, 262)  # D + ΔD, 6×12 row-major (summed once per episode)
-STATE_WIDTH = 262
+HELD_COMMAND = slice(262, 268)  # the Γ_c THRUSTER_OUTPUT, HELD_WRENCH and HELD_FED were made of
+HELD_WRENCH = slice(268, 274)  # Γ_actual of Γ_c, eqs. (10)-(12)
+HELD_FED = slice(274, 280)  # what the ESO is fed for Γ_c (controller.eso_input)
+STATE_WIDTH = 280
 """Layout of the state row."""
 
 INTEGRAL = slice(14, 16)
@@ -116,8 +121,11 @@ def controller_view(t: float, y: np.ndarray, c: np.ndarray, gains: ControllerGai
     z2 = c[6:12]
     phi_hat = c[12:14]
     fixed_gain = fixed_gain_feedback(drift, z2, surface, gains)
-    command = control_law(fixed_gain, surface, adaptive_gain(phi_hat, c[14:16], surface, t, gains))
-    fresh = control_law(fixed_gain, surface, adaptive_gain(phi_hat, np.zeros(2), surface, t, gains))
+    denominator = adaptive_denominator(block_norms(surface), t, gains)
+    integral = c[14:16]
+    command = control_law(fixed_gain, surface, adaptive_gain(phi_hat, integral, denominator, gains))
+    restarted = adaptive_gain(phi_hat, np.zeros(2), denominator, gains)
+    fresh = control_law(fixed_gain, surface, restarted)
     return eta, surface, drift, known, command, fresh
 
 
@@ -139,19 +147,19 @@ def total_disturbance(
     t: float,
     y: np.ndarray,
     wrench: np.ndarray,
-    held: np.ndarray,
+    fed: np.ndarray,
     known: np.ndarray,
     model: PlantModel,
     gains: ControllerGains,
 ) -> np.ndarray:
     """The true Δd = dṼ/dt - (H + Ξ⁻¹f(Ξ)) - Ξ⁻¹Γ_c of eq. (9), from the true plant.
 
-    ``wrench`` is what the thrusters really apply for the held command ``held``; Γ_c is what
-    the ESO is fed (:func:`~etsc_envs.orbit_attitude.controller.eso_input`), so Δd is exactly
-    the extended state Z2 the ESO estimates.
+    ``wrench`` is what the thrusters really apply for the held command; Γ_c here is ``fed``,
+    what the ESO is fed for it (:func:`~etsc_envs.orbit_attitude.controller.eso_input`), so Δd
+    is exactly the extended state Z2 the ESO estimates.
     """
     true_rate = relative_derivative(t, y, (wrench, model))[7:13]
-    return true_rate - known - inertia_solve(eso_input(held, gains), gains)
+    return true_rate - known - inertia_solve(fed, gains)
 
 
 @jit
@@ -174,6 +182,30 @@ def disturbance_step(
 
 
 @jit
+def abs_max(x: np.ndarray) -> float:
+    """``np.abs(x).max()`` without the temporary: the largest |x_i|, or the first NaN."""
+    largest = np.abs(x[0])
+    for i in range(x.size):
+        value = np.abs(x[i])
+        if np.isnan(value):
+            return value
+        if value > largest:
+            largest = value
+    return largest
+
+
+@jit
+def all_finite(x: np.ndarray) -> bool:
+    """``np.isfinite(x).all()`` without the temporary."""
+    finite = True
+    for i in range(x.size):
+        if not np.isfinite(x[i]):
+            finite = False
+            break
+    return finite
+
+
+@jit
 def tracking_cost(eta: np.ndarray, twist_error: np.ndarray, reference: np.ndarray) -> float:
     """Per-step accuracy cost ``¼ Σ_j log(1 + ‖x_j‖ / ref_j)`` for x = Φ, Δω, χ, Δv."""
     cost = np.log1p(np.sqrt(fused_dot(eta[0:3], eta[0:3])) / reference[0])
@@ -191,6 +223,7 @@ def closed_loop_step(
     y: np.ndarray,
     c: np.ndarray,
     held: np.ndarray,
+    response: tuple,
     model: PlantModel,
     gains: ControllerGains,
     view: np.ndarray,
@@ -199,27 +232,30 @@ def closed_loop_step(
 ):
     """Advance plant and controller from t to t + h with the held command ``held``.
 
-    ``view = [S(t), H1(t)]`` is what the controller evaluated at t (returned by the previous
-    step, or :func:`initial_view`). Returns ``(y_next, c_next, fresh_command, features,
-    view_next, cost, diagnostics, thruster_output)``: the states at t + h, the command a
-    transmission at t + h would send, the observation features and ``[S, H1]`` there, the
-    step's :func:`tracking_cost` at t + h, the :data:`N_DIAGNOSTICS` summary (its maxima of the
-    ESO errors ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at t + h, Δd with the command held over the
-    period just simulated, are computed only if ``with_disturbance``, else zero), and the
-    thruster outputs u_a over the period (N).
+    ``response = (u_a, Γ_actual, fed)`` is what the thrusters and the ESO make of ``held``
+    (:func:`hold_command`). ``view = [S(t), H1(t)]`` is what the controller evaluated at t
+    (returned by the previous step, or :func:`initial_view`). Returns ``(y_next, c_next,
+    fresh_command, features, view_next, cost, diagnostics)``: the states at t + h, the command
+    a transmission at t + h would send, the observation features and ``[S, H1]`` there, the
+    step's :func:`tracking_cost` at t + h, and the :data:`N_DIAGNOSTICS` summary (its maxima of
+    the ESO errors ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at t + h, Δd with the command held over
+    the period just simulated, are computed only if ``with_disturbance``, else zero).
     """
     # controller at t: ESO, adaptive law and the integral of eq. (23), forward Euler
     surface = view[0:6]
     drift = view[6:12]
-    dz1, dz2 = eso_derivative(c[0:6], c[6:12], surface, drift, eso_input(held, gains), gains)
-    c_next = c.copy()
-    c_next[0:6] += h * dz1
-    c_next[6:12] += h * dz2
-    c_next[12:14] += h * adaptive_derivative(c[12:14], surface, t, gains)
-    c_next[14:16] += h * c[12:14]
+    output, wrench, fed = response
+    dz1, dz2 = eso_derivative(c[0:6], c[6:12], surface, drift, fed, gains)
+    dphi = adaptive_derivative(c[12:14], surface, t, gains)
+    c_next = np.empty(16)
+    for i in range(6):
+        c_next[i] = c[i] + h * dz1[i]
+        c_next[6 + i] = c[6 + i] + h * dz2[i]
+    for j in range(2):
+        c_next[12 + j] = c[12 + j] + h * dphi[j]
+        c_next[14 + j] = c[14 + j] + h * c[12 + j]
 
     # plant over [t, t + h) under the held command (ZOH at the thrusters)
-    _, output, wrench = thruster_outputs(held, model)
     y_next = y
     dt = h / substeps
     for i in range(substeps):
@@ -233,29 +269,35 @@ def closed_loop_step(
     view_next = np.empty(12)
     view_next[0:6] = surface
     view_next[6:12] = drift
-    e1 = c_next[0:6] - surface
-    e2 = np.zeros(6)
-    if with_disturbance:
-        e2 = c_next[6:12] - total_disturbance(t_next, y_next, wrench, held, known, model, gains)
+    e1 = np.empty(6)
+    for i in range(6):
+        e1[i] = c_next[i] - surface[i]
     twist_error = y_next[7:13]
     cost = tracking_cost(eta, twist_error, cost_reference)
-    e2_physical = inertia_times(e2, gains)
     diagnostics = np.empty(N_DIAGNOSTICS)
     diagnostics[0] = np.sqrt(fused_dot(eta[0:3], eta[0:3]))
     diagnostics[1] = np.sqrt(fused_dot(eta[3:6], eta[3:6]))
-    diagnostics[2] = np.abs(eta[0:3]).max()
-    diagnostics[3] = np.abs(twist_error[0:3]).max()
-    diagnostics[4] = np.abs(eta[3:6]).max()
-    diagnostics[5] = np.abs(twist_error[3:6]).max()
-    diagnostics[6] = np.abs(e1[0:3]).max()
-    diagnostics[7] = np.abs(e1[3:6]).max()
-    diagnostics[8] = np.abs(e2_physical[0:3]).max()
-    diagnostics[9] = np.abs(e2_physical[3:6]).max()
-    diagnostics[10] = h * np.abs(output).sum()
+    diagnostics[2] = abs_max(eta[0:3])
+    diagnostics[3] = abs_max(twist_error[0:3])
+    diagnostics[4] = abs_max(eta[3:6])
+    diagnostics[5] = abs_max(twist_error[3:6])
+    diagnostics[6] = abs_max(e1[0:3])
+    diagnostics[7] = abs_max(e1[3:6])
+    diagnostics[8] = 0.0
+    diagnostics[9] = 0.0
+    if with_disturbance:
+        e2 = c_next[6:12] - total_disturbance(t_next, y_next, wrench, fed, known, model, gains)
+        e2_physical = inertia_times(e2, gains)
+        diagnostics[8] = abs_max(e2_physical[0:3])
+        diagnostics[9] = abs_max(e2_physical[3:6])
+    total_output = 0.0
+    for i in range(output.size):
+        total_output += np.abs(output[i])
+    diagnostics[10] = h * total_output
     diagnostics[11] = np.sqrt(fused_dot(twist_error[0:3], twist_error[0:3]))
     diagnostics[12] = np.sqrt(fused_dot(twist_error[3:6], twist_error[3:6]))
-    diagnostics[13] = 1.0 if np.isfinite(y_next).all() and np.isfinite(features).all() else 0.0
-    return y_next, c_next, fresh, features, view_next, cost, diagnostics, output
+    diagnostics[13] = 1.0 if all_finite(y_next) and all_finite(features) else 0.0
+    return y_next, c_next, fresh, features, view_next, cost, diagnostics
 
 
 @jit
@@ -368,6 +410,32 @@ def channel_values(state: np.ndarray, constants: LoopConstants, time_s: float) -
 
 
 @jit
+def hold_command(
+    state: np.ndarray, command: np.ndarray, model: PlantModel, gains: ControllerGains
+) -> None:
+    """Store in the state row what the thrusters (eqs. 10-12: u_a, Γ_actual) and the ESO's
+    model (:func:`~etsc_envs.orbit_attitude.controller.eso_input`) make of the held ``command``.
+
+    They depend on nothing else, so they are computed once per transmission, not every step.
+    """
+    _, state[THRUSTER_OUTPUT], state[HELD_WRENCH] = thruster_outputs(command, model)
+    state[HELD_FED] = eso_input(command, gains)
+    state[HELD_COMMAND] = command
+
+
+@jit
+def holds(state: np.ndarray, command: np.ndarray) -> bool:
+    """Whether the state row's :func:`hold_command` values were made of ``command``."""
+    stored = state[HELD_COMMAND]
+    same = True
+    for i in range(stored.size):
+        if command[i] != stored[i]:
+            same = False
+            break
+    return same
+
+
+@jit
 def advance_loop(
     state: np.ndarray,
     constants: LoopConstants,
@@ -381,6 +449,10 @@ def advance_loop(
     if sent[0] != 0:  # a transmission at t_k restarts ∫_{t_k} ϕ̂ ds of eq. (23)
         state[CONTROLLER][INTEGRAL] = 0.0
     steady = step_index + 1 > constants.steady_start
+    model = episode_model(state, constants)
+    gains = episode_gains(state, constants)
+    if not holds(state, held[0]):
+        hold_command(state, held[0], model, gains)
     (
         state[PLANT],
         state[CONTROLLER],
@@ -389,7 +461,6 @@ def advance_loop(
         state[VIEW],
         channel_costs[0],
         state[DIAGNOSTICS],
-        state[THRUSTER_OUTPUT],
     ) = closed_loop_step(
         step_index * h,
         h,
@@ -397,8 +468,9 @@ def advance_loop(
         state[PLANT],
         state[CONTROLLER],
         held[0],
-        episode_model(state, constants),
-        episode_gains(state, constants),
+        (state[THRUSTER_OUTPUT], state[HELD_WRENCH], state[HELD_FED]),
+        model,
+        gains,
         state[VIEW],
         constants.cost_reference,
         steady,

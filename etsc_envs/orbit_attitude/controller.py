@@ -27,10 +27,9 @@ from etsc_envs.core.linalg import (
     fused_dot,
     fused_matmul,
     fused_matvec3,
-    fused_matvec3_transposed,
+    fused_matvec6,
 )
 from etsc_envs.core.rotations import (
-    cross,
     se3_ad,
     se3_adjoint,
     se3_inverse,
@@ -80,9 +79,18 @@ ControllerGains = namedtuple(
 
 
 @jit
-def sig(x: np.ndarray, power: float) -> np.ndarray:
-    """``sig^a(x) = |x|^a sign(x)`` elementwise."""
+def signed_power(x: float, power: float) -> float:
+    """``sig^a(x) = |x|^a sign(x)`` of a scalar."""
     return np.sign(x) * np.abs(x) ** power
+
+
+@jit
+def sig(x: np.ndarray, power: float) -> np.ndarray:
+    """``sig^a(x) = |x|^a sign(x)`` elementwise (:func:`signed_power`)."""
+    out = np.empty(x.size)
+    for i in range(x.size):
+        out[i] = signed_power(x[i], power)
+    return out
 
 
 @jit
@@ -91,15 +99,6 @@ def block_norms(x: np.ndarray) -> np.ndarray:
     out = np.empty(2)
     out[0] = np.sqrt(fused_dot(x[0:3], x[0:3]))
     out[1] = np.sqrt(fused_dot(x[3:6], x[3:6]))
-    return out
-
-
-@jit
-def scale_blocks(x: np.ndarray, pair: np.ndarray) -> np.ndarray:
-    """``diag(pair[0] I3, pair[1] I3) x``."""
-    out = x.copy()
-    out[0:3] *= pair[0]
-    out[3:6] *= pair[1]
     return out
 
 
@@ -138,36 +137,45 @@ def known_dynamics(
     rotation_a = np.ascontiguousarray(g_a[:3, :3])
     position = np.ascontiguousarray(g_a[:3, 3])
     desired = leader_twist(leader)
-    desired_in_body = se3_adjoint(se3_inverse(g_e)) @ desired  # Ad_{g_e⁻¹} V_d
+    desired_in_body = fused_matvec6(se3_adjoint(se3_inverse(g_e)), desired)  # Ad_{g_e⁻¹} V_d
     twist = twist_error + desired_in_body
     omega = np.ascontiguousarray(twist[0:3])
     velocity = np.ascontiguousarray(twist[3:6])
 
-    out = np.empty(6)
     # Ξ⁻¹ ad*_V Ξ V = [J⁻¹(-ω × Jω - v × m v), -ω × v]; v × m v = 0 is dropped exactly rather
     # than left to rounding (~1e-6 N·m at orbital speed).
-    out[0:3] = fused_matvec3(gains.inertia_inv, -cross(omega, fused_matvec3(gains.inertia, omega)))
-    out[3:6] = -cross(omega, velocity)
+    inertia_inv = gains.inertia_inv
+    free_rate = vec3.matvec(
+        inertia_inv, vec3.negate(vec3.cross(omega, vec3.matvec(gains.inertia, omega)))
+    )
+    free_acceleration = vec3.negate(vec3.cross(omega, velocity))
     # + ad_Ṽ Ad_{g_e⁻¹} V_d  (V̇_d = 0 on the circular orbit)
-    out += se3_ad(twist_error) @ desired_in_body
+    out = fused_matvec6(se3_ad(twist_error), desired_in_body)
     # + Ξ⁻¹ f(Ξ): gravity-gradient moment and gravity force with J2, nominal J and m
-    position_body = fused_matvec3_transposed(rotation_a, position)
-    out[0:3] += fused_matvec3(
-        gains.inertia_inv, gravity_gradient_torque(position_body, gains.inertia, leader.mu)
+    position_body = vec3.matvec_transposed(rotation_a, position)
+    gradient_rate = vec3.matvec(
+        inertia_inv, gravity_gradient_torque(position_body, gains.inertia, leader.mu)
     )
     acceleration = kepler_gravity(position, leader.mu)
     if gains.j2 != 0.0:
         acceleration = vec3.add(
             acceleration, j2_acceleration(position, leader.mu, gains.earth_radius, gains.j2)
         )
-    out[3:6] += fused_matvec3_transposed(rotation_a, acceleration)
+    gravity_body = vec3.matvec_transposed(rotation_a, acceleration)
+    for i in range(3):
+        out[i] = (free_rate[i] + out[i]) + gradient_rate[i]
+        out[3 + i] = (free_acceleration[i] + out[3 + i]) + gravity_body[i]
     return out
 
 
 @jit
 def sliding_surface(eta: np.ndarray, twist_error: np.ndarray, gains: ControllerGains):
     """FTSM ``S = Ṽ + ϑ1 η̃ + ϑ2 sig^α(η̃)`` (section III-B)."""
-    return twist_error + gains.theta1 * eta + gains.theta2 * sig(eta, gains.alpha)
+    theta1, theta2, alpha = gains.theta1, gains.theta2, gains.alpha
+    out = np.empty(6)
+    for i in range(6):
+        out[i] = twist_error[i] + theta1[i] * eta[i] + theta2[i] * signed_power(eta[i], alpha)
+    return out
 
 
 @jit
@@ -179,13 +187,18 @@ def surface_drift(
     ``known`` is :func:`known_dynamics`. The factor ``|η̃_i|^(α-1)`` is singular where a
     component of η̃ crosses zero; |η̃_i| is floored at ``gains.singularity_floor``.
     """
-    eta_rate = se3_right_jacobian_inverse(eta) @ twist_error  # η̃̇ = G(η̃) Ṽ, eq. (7)
-    magnitude = np.maximum(np.abs(eta), gains.singularity_floor)
-    return (
-        known
-        + gains.theta1 * eta_rate
-        + gains.alpha * gains.theta2 * magnitude ** (gains.alpha - 1.0) * eta_rate
-    )
+    eta_rate = fused_matvec6(se3_right_jacobian_inverse(eta), twist_error)  # η̃̇ = G(η̃)Ṽ, eq. 7
+    theta1, theta2, alpha = gains.theta1, gains.theta2, gains.alpha
+    floor = gains.singularity_floor
+    out = np.empty(6)
+    for i in range(6):
+        magnitude = np.maximum(np.abs(eta[i]), floor)
+        out[i] = (
+            known[i]
+            + theta1[i] * eta_rate[i]
+            + alpha * theta2[i] * magnitude ** (alpha - 1.0) * eta_rate[i]
+        )
+    return out
 
 
 @jit
@@ -219,31 +232,40 @@ def eso_derivative(
     Returns ``(dẐ1/dt, dẐ2/dt)``.
     """
     beta, a1, a2 = gains.beta, gains.alpha1, gains.alpha2
-    e1 = z1 - surface
-    sig1 = sig(e1, a1)
-    dz1 = (
-        drift
-        + inertia_solve(command, gains)
-        + z2
-        - gains.k1 * beta**a1 * sig1
-        - gains.k2 * beta * e1
-    )
-    dz2 = (
-        -gains.k3 * beta ** (2.0 * a1) * sig(e1, a2)
-        - gains.k4 * beta ** (a1 + 1.0) * sig1
-        - gains.k5 * beta * beta * e1
-    )
+    beta_a1, beta_2a1, beta_a1_1 = beta**a1, beta ** (2.0 * a1), beta ** (a1 + 1.0)
+    k1, k2, k3, k4, k5 = gains.k1, gains.k2, gains.k3, gains.k4, gains.k5
+    fed = inertia_solve(command, gains)
+    dz1 = np.empty(6)
+    dz2 = np.empty(6)
+    for i in range(6):
+        e1 = z1[i] - surface[i]
+        sig1 = signed_power(e1, a1)
+        dz1[i] = drift[i] + fed[i] + z2[i] - k1[i] * beta_a1 * sig1 - k2[i] * beta * e1
+        dz2[i] = (
+            -k3[i] * beta_2a1 * signed_power(e1, a2)
+            - k4[i] * beta_a1_1 * sig1
+            - k5[i] * beta * beta * e1
+        )
     return dz1, dz2
 
 
 @jit
+def adaptive_denominator(norms: np.ndarray, t: float, gains: ControllerGains) -> np.ndarray:
+    """``‖S̄_j‖ + ϵ_j exp(-σ_j t)``, j = 1, 2, from ``norms = ‖S̄_j‖`` (:func:`block_norms`):
+    the denominator of K3 in eq. (23) and of eq. (24)."""
+    out = np.empty(2)
+    for j in range(2):
+        out[j] = norms[j] + gains.epsilon[j] * np.exp(-gains.sigma[j] * t)
+    return out
+
+
+@jit
 def adaptive_gain(
-    phi_hat: np.ndarray, integral: np.ndarray, surface: np.ndarray, t: float, gains: ControllerGains
+    phi_hat: np.ndarray, integral: np.ndarray, denominator: np.ndarray, gains: ControllerGains
 ) -> np.ndarray:
-    """``K3j = (ϕ̂_j + ℓ_j ∫_{t_k}^t ϕ̂_j ds) / (‖S̄_j‖ + ϵ_j exp(-σ_j t))`` (eq. 23), j = 1, 2."""
-    return (phi_hat + gains.ell * integral) / (
-        block_norms(surface) + gains.epsilon * np.exp(-gains.sigma * t)
-    )
+    """``K3j = (ϕ̂_j + ℓ_j ∫_{t_k}^t ϕ̂_j ds) / (‖S̄_j‖ + ϵ_j exp(-σ_j t))`` (eq. 23), j = 1, 2,
+    with the denominator of :func:`adaptive_denominator`."""
+    return (phi_hat + gains.ell * integral) / denominator
 
 
 @jit
@@ -252,7 +274,11 @@ def adaptive_derivative(
 ) -> np.ndarray:
     """``ϕ̂_j' = -ℓ_j ϕ̂_j + ‖S̄_j‖² / (‖S̄_j‖ + ϵ_j exp(-σ_j t))`` (eq. 24)."""
     norms = block_norms(surface)
-    return -gains.ell * phi_hat + norms * norms / (norms + gains.epsilon * np.exp(-gains.sigma * t))
+    denominator = adaptive_denominator(norms, t, gains)
+    out = np.empty(2)
+    for j in range(2):
+        out[j] = -gains.ell[j] * phi_hat[j] + norms[j] * norms[j] / denominator[j]
+    return out
 
 
 @jit
@@ -260,18 +286,24 @@ def fixed_gain_feedback(
     drift: np.ndarray, z2: np.ndarray, surface: np.ndarray, gains: ControllerGains
 ) -> np.ndarray:
     """``-Ξ(H1 + Ẑ2) - K1 sig^α(S) - K2 S``: the part of eq. (22) without the adaptive K3."""
-    return (
-        -inertia_times(drift + z2, gains)
-        - gains.gain_k1 * sig(surface, gains.alpha)
-        - gains.gain_k2 * surface
-    )
+    total = np.empty(6)
+    for i in range(6):
+        total[i] = drift[i] + z2[i]
+    out = inertia_times(total, gains)
+    gain_k1, gain_k2, alpha = gains.gain_k1, gains.gain_k2, gains.alpha
+    for i in range(6):
+        out[i] = -out[i] - gain_k1[i] * signed_power(surface[i], alpha) - gain_k2[i] * surface[i]
+    return out
 
 
 @jit
 def control_law(fixed_gain: np.ndarray, surface: np.ndarray, k3: np.ndarray) -> np.ndarray:
     """``Γ_cout = -Ξ(H1 + Ẑ2) - K1 sig^α(S) - (K2 + K3) S`` (eq. 22): [τ (N·m), u (N)], from
     :func:`fixed_gain_feedback` and the adaptive gains K3 = [K31, K32]."""
-    return fixed_gain - scale_blocks(surface, k3)
+    out = np.empty(6)
+    for i in range(6):
+        out[i] = fixed_gain[i] - surface[i] * k3[i // 3]
+    return out
 
 
 @jit

@@ -49,11 +49,18 @@ from etsc_envs.orbit_attitude.closed_loop import (
     episode_gains,
     episode_leader,
     episode_model,
+    hold_command,
     initial_view,
     total_disturbance,
     tracking_cost,
 )
-from etsc_envs.orbit_attitude.controller import ControllerGains, adaptive_gain
+from etsc_envs.orbit_attitude.controller import (
+    ControllerGains,
+    adaptive_denominator,
+    adaptive_gain,
+    block_norms,
+    eso_input,
+)
 from etsc_envs.orbit_attitude.dynamics import (
     LeaderOrbit,
     PlantModel,
@@ -354,7 +361,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         features[6:12] = surface
         features[12:18] = eta
         features[18:24] = state[PLANT][7:13]
-        state[THRUSTER_OUTPUT] = thruster_outputs(state[COMMAND], self.model)[1]
+        hold_command(state, state[COMMAND], self.model, self.gains)
         initial_norms = np.array([np.linalg.norm(phi), np.linalg.norm(chi)])
         state[SETTLING_BOUND] = SETTLING_BAND * initial_norms
         state[SETTLING_TIME] = np.where(initial_norms > 0.0, np.nan, 0.0)
@@ -427,7 +434,8 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
         eta, surface, _, known, command, fresh = controller_view(t, y, c, gains)
         held = self.held[0].copy()
         wrench = thruster_outputs(held, model)[2]
-        disturbance = total_disturbance(t, y, wrench, held, known, model, gains)
+        denominator = adaptive_denominator(block_norms(surface), t, gains)
+        disturbance = total_disturbance(t, y, wrench, eso_input(held, gains), known, model, gains)
         return {
             "time_s": np.array(t),
             "eta": eta,
@@ -439,7 +447,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
             "e1": c[0:6] - surface,
             "e2": c[6:12] - disturbance,
             "phi_hat": c[12:14].copy(),
-            "k3": adaptive_gain(c[12:14], c[14:16], surface, t, gains),
+            "k3": adaptive_gain(c[12:14], c[14:16], denominator, gains),
             "command": command,
             "fresh_command": fresh,
             "held_command": held,
