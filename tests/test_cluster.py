@@ -46,6 +46,7 @@ from baselines.reproductions import cluster as reproduction
 from etsc_envs import cluster_containment_v0
 from etsc_envs.cluster.closed_loop import integrate_loop
 from etsc_envs.cluster.controller import regressor
+from etsc_envs.cluster.dynamics import attitude_rate
 from etsc_envs.cluster.env import FEATURE_NAMES, cluster_model, hull_distance
 from etsc_envs.cluster.params import (
     FIGURE_2_EDGES,
@@ -413,7 +414,7 @@ def test_regressor_is_the_euler_lagrange_form_of_the_rigid_body():
         g_dot = (g_of(sigma + 1e-6 * sigma_dot) - g_of(sigma - 1e-6 * sigma_dot)) / 2e-6
         sigma_ddot = g_dot @ omega + g @ omega_dot
         expected = np.linalg.solve(g.T, inertia @ omega_dot + np.cross(omega, inertia @ omega))
-        y = regressor(sigma, omega, sigma_dot, sigma_ddot)
+        y = np.array(regressor(sigma, omega, attitude_rate(sigma, omega), sigma_dot, sigma_ddot))
         assert_allclose(y @ theta, expected, rtol=1e-7, atol=1e-8)
 
 

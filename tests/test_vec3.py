@@ -8,6 +8,7 @@ from numba import njit
 from numpy.testing import assert_allclose
 
 from etsc_envs.core import vec3
+from etsc_envs.core.linalg import matvec, matvec_transposed
 from etsc_envs.core.rotations import quat_multiply, quat_product
 
 
@@ -128,3 +129,39 @@ def test_helpers_accept_array_views(helper):
     row = np.arange(10.0)
     view = row[2:5]
     assert np.array_equal(np.asarray(helper(view, view)), np.asarray(helper(tuple(view), view)))
+
+
+@njit
+def _loop_products(matrix, wide, a):
+    return matvec(matrix, a), matvec_transposed(matrix, a), matvec_transposed(wide, a)
+
+
+@njit
+def _from_zero_helpers(matrix, wide, a):
+    columns = np.empty(wide.shape[1])
+    for column in range(wide.shape[1]):
+        columns[column] = vec3.column_dot_from_zero(wide, column, a)
+    return (
+        vec3.matvec_from_zero(matrix, a),
+        vec3.matvec_transposed_from_zero(matrix, a),
+        columns,
+    )
+
+
+def test_from_zero_helpers_return_the_bits_of_the_linalg_loops():
+    """The ``*_from_zero`` helpers sum as the loops of :mod:`etsc_envs.core.linalg` do (no
+    BLAS involved), for array rows and tuple rows alike."""
+    rng = np.random.default_rng(24)
+    for _ in range(500):
+        a, _, matrix, *_ = _inputs(rng)
+        wide = rng.normal(size=(3, 6)) * 10.0 ** rng.uniform(-6, 4, size=(3, 1))
+        expected = _loop_products(matrix, wide, a)
+        rows = tuple(tuple(row) for row in matrix)
+        for computed in (
+            _from_zero_helpers(matrix, wide, a),
+            _from_zero_helpers(matrix, wide, _as_tuple(a)),
+        ):
+            for got, want in zip(computed, expected, strict=True):
+                assert np.array_equal(np.asarray(got), want)
+        assert np.array_equal(np.asarray(vec3.matvec_from_zero(rows, a)), expected[0])
+        assert np.array_equal(vec3.to_matrix(rows), matrix)

@@ -20,22 +20,23 @@ import numpy as np
 
 from etsc_envs.cluster.controller import (
     control_law,
-    parameter_rate,
     reference_rates,
     regressor,
+    regressor_times,
     switching_gain_derivative,
     trigger_errors,
+    write_parameter_rate,
 )
 from etsc_envs.cluster.dynamics import (
     ClusterModel,
-    attitude_rates,
     body_acceleration,
-    containment_errors,
+    containment_error,
+    write_attitude_rates,
 )
+from etsc_envs.core import vec3
 from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import matvec
 
 SAMPLE_WIDTH = 9
 N_FEATURES = 19
@@ -78,36 +79,50 @@ def follower_table(state: np.ndarray) -> np.ndarray:
 
 
 @jit
+def sliding_signals(follower: int, y: np.ndarray, sigma_dot: np.ndarray, model: ClusterModel):
+    """s_i of eq. (10) and Y_i of eq. (13) of ``follower`` at the N×13 state ``y``, given every
+    follower's σ̇ (eq. 2) in ``sigma_dot`` (N×3). Returns ``(s, regressor_rows)``."""
+    sigma_r_dot, sigma_r_ddot = reference_rates(follower, y[:, 0:3], sigma_dot, model)
+    own_rate = vec3.as_vec3(sigma_dot[follower])
+    s = vec3.subtract(own_rate, sigma_r_dot)
+    rows = regressor(y[follower, 0:3], y[follower, 3:6], own_rate, sigma_r_dot, sigma_r_ddot)
+    return s, rows
+
+
+@jit
 def follower_signals(y: np.ndarray, model: ClusterModel):
-    """σ̇, s (eq. 10) and Y (eq. 13) of every follower at state ``y``.
+    """σ̇ (eq. 2), s (eq. 10) and Y (eq. 13) of every follower at state ``y``, as arrays (for
+    diagnostics; the step uses :func:`sliding_signals`).
 
     Returns ``(sigma_dot, s, regressors)`` with shapes N×3, N×3 and N×3×6.
     """
     n = y.shape[0]
-    sigma = np.ascontiguousarray(y[:, 0:3])
-    omega = np.ascontiguousarray(y[:, 3:6])
-    sigma_dot = attitude_rates(sigma, omega)
-    sigma_r_dot, sigma_r_ddot = reference_rates(sigma, sigma_dot, model)
-    s = sigma_dot - sigma_r_dot
+    sigma_dot = np.empty((n, 3))
+    s = np.empty((n, 3))
     regressors = np.empty((n, 3, 6))
+    write_attitude_rates(y, sigma_dot)
     for i in range(n):
-        regressors[i] = regressor(sigma[i], omega[i], sigma_r_dot[i], sigma_r_ddot[i])
+        s_i, rows = sliding_signals(i, y, sigma_dot, model)
+        vec3.store(s[i], s_i)
+        for row in range(3):
+            for column in range(6):
+                regressors[i, row, column] = rows[row][column]
     return sigma_dot, s, regressors
 
 
 @jit
 def loop_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
-    """ẏ: eq. (2) σ̇ = Gω, eq. (4) ω̇ with the held controls ``args[0]`` (N×3), eqs. (20)-(21)."""
+    """ẏ: eq. (2) σ̇ = Gω, eq. (4) ω̇ with the held controls u_i = ``args[0][i, 0:3]``,
+    eqs. (20)-(21)."""
     control, model = args
-    sigma_dot, s, regressors = follower_signals(y, model)
     dy = np.empty_like(y)
+    sigma_dot = dy[:, 0:3]
+    write_attitude_rates(y, sigma_dot)
     for i in range(y.shape[0]):
-        sigma = np.ascontiguousarray(y[i, 0:3])
-        omega = np.ascontiguousarray(y[i, 3:6])
-        dy[i, 0:3] = sigma_dot[i]
-        dy[i, 3:6] = body_acceleration(t, i, sigma, omega, control[i], model)
-        dy[i, 6:12] = parameter_rate(regressors[i], s[i], model)
-        dy[i, 12] = switching_gain_derivative(s[i], model)
+        s, rows = sliding_signals(i, y, sigma_dot, model)
+        vec3.store(dy[i, 3:6], body_acceleration(t, i, y[i, 0:3], y[i, 3:6], control[i], model))
+        write_parameter_rate(dy[i, 6:12], rows, s, model)
+        dy[i, 12] = switching_gain_derivative(s, model)
     return dy
 
 
@@ -115,72 +130,52 @@ integrate_loop = make_rk4_step(loop_derivative)
 
 
 @jit
-def event_samples(y: np.ndarray, model: ClusterModel) -> np.ndarray:
-    """What an event of each follower would send now: ``[u_i, s_i, Y_iΘ̂_i]`` (N×9), with u_i
-    the control law eq. (19) at the current s_i, Y_iΘ̂_i and k̂_i."""
-    _, s, regressors = follower_signals(y, model)
-    samples = np.empty((y.shape[0], SAMPLE_WIDTH))
+def write_event_samples(y: np.ndarray, model: ClusterModel, out: np.ndarray) -> None:
+    """Write what an event of each follower would send now into ``out`` (N×9):
+    ``[u_i, s_i, Y_iΘ̂_i]``, with u_i the control law eq. (19) at the current s_i, Y_iΘ̂_i
+    and k̂_i."""
+    sigma_dot = np.empty((y.shape[0], 3))
+    write_attitude_rates(y, sigma_dot)
     for i in range(y.shape[0]):
-        y_theta = matvec(regressors[i], y[i, 6:12])
-        samples[i, 0:3] = control_law(s[i], y_theta, y[i, 12], model)
-        samples[i, 3:6] = s[i]
-        samples[i, 6:9] = y_theta
-    return samples
+        s, rows = sliding_signals(i, y, sigma_dot, model)
+        y_theta = regressor_times(rows, y[i, 6:12])
+        vec3.store(out[i, 0:3], control_law(s, y_theta, y[i, 12], model))
+        vec3.store(out[i, 3:6], s)
+        vec3.store(out[i, 6:9], y_theta)
 
 
 @jit
-def agent_features(
-    t: float, y: np.ndarray, samples: np.ndarray, held: np.ndarray, model: ClusterModel
-) -> np.ndarray:
-    """Each follower's view at ``t`` (N×19, see ``FEATURE_NAMES`` of the environment).
+def write_agent_features(
+    t: float,
+    y: np.ndarray,
+    samples: np.ndarray,
+    held: np.ndarray,
+    model: ClusterModel,
+    out: np.ndarray,
+) -> None:
+    """Write each follower's view at ``t`` into ``out`` (N×19, see ``FEATURE_NAMES`` of the
+    environment).
 
     ``samples`` are the current ``[τ, s, YΘ̂]`` rows and ``held`` the rows of the last event.
     """
-    n = y.shape[0]
-    features = np.empty((n, N_FEATURES))
     gain_max = model.control_gain.max()
     gain_min = model.control_gain.min()
-    for i in range(n):
-        s = np.ascontiguousarray(samples[i, 3:6])
-        e_j, e_s = trigger_errors(
-            s,
-            np.ascontiguousarray(samples[i, 6:9]),
-            np.ascontiguousarray(held[i, 3:6]),
-            np.ascontiguousarray(held[i, 6:9]),
-        )
-        s_norm = np.sqrt(s @ s)
-        features[i, 0] = e_j + gain_max * e_s
-        features[i, 1] = 0.5 * gain_min * s_norm
-        features[i, 2] = e_j
-        features[i, 3] = e_s
-        features[i, 4] = s_norm
-        features[i, 5] = np.sqrt(gain_min)
-        features[i, 6] = t
-        features[i, 7:10] = y[i, 0:3]
-        features[i, 10:13] = y[i, 3:6]
-        features[i, 13:16] = y[i, 0:3] - model.targets[i]
-        features[i, 16:19] = held[i, 0:3]
-    return features
-
-
-@jit
-def closed_loop_step(t: float, h: float, y: np.ndarray, held: np.ndarray, model: ClusterModel):
-    """Advance every follower from t_k to t_k + h with the held event rows ``held`` (N×9).
-
-    Returns ``(y_next, samples_next, features_next, errors_next, norms_next)``: the state,
-    what an event would send at t_k + h, each follower's observation features there,
-    ‖σ_i - σ_d,i‖, and the N×2 norms [‖σ_i‖, ‖ω_i‖] (for the failure bounds).
-    """
-    control = np.ascontiguousarray(held[:, 0:3])
-    y_next = integrate_loop(t, y, h, (control, model))
-    samples = event_samples(y_next, model)
-    features = agent_features(t + h, y_next, samples, held, model)
-    errors = containment_errors(np.ascontiguousarray(y_next[:, 0:3]), model)
-    norms = np.empty((y.shape[0], 2))
     for i in range(y.shape[0]):
-        norms[i, 0] = np.sqrt(y_next[i, 0] ** 2 + y_next[i, 1] ** 2 + y_next[i, 2] ** 2)
-        norms[i, 1] = np.sqrt(y_next[i, 3] ** 2 + y_next[i, 4] ** 2 + y_next[i, 5] ** 2)
-    return y_next, samples, features, errors, norms
+        features = out[i]
+        s = samples[i, 3:6]
+        e_j, e_s = trigger_errors(s, samples[i, 6:9], held[i, 3:6], held[i, 6:9])
+        s_norm = np.sqrt(vec3.dot(s, s))
+        features[0] = e_j + gain_max * e_s
+        features[1] = 0.5 * gain_min * s_norm
+        features[2] = e_j
+        features[3] = e_s
+        features[4] = s_norm
+        features[5] = np.sqrt(gain_min)
+        features[6] = t
+        vec3.store(features[7:10], y[i, 0:3])
+        vec3.store(features[10:13], y[i, 3:6])
+        vec3.store(features[13:16], vec3.subtract(y[i, 0:3], model.targets[i]))
+        vec3.store(features[16:19], held[i, 0:3])
 
 
 @jit
@@ -238,6 +233,14 @@ def channel_values(state: np.ndarray, constants: LoopConstants, time_s: float) -
 
 
 @jit
+def write_norms(table: np.ndarray) -> None:
+    """Write every follower's [‖σ_i‖, ‖ω_i‖] (for the failure bounds) into its record."""
+    for i in range(table.shape[0]):
+        table[i, NORMS.start] = np.sqrt(table[i, 0] ** 2 + table[i, 1] ** 2 + table[i, 2] ** 2)
+        table[i, NORMS.start + 1] = np.sqrt(table[i, 3] ** 2 + table[i, 4] ** 2 + table[i, 5] ** 2)
+
+
+@jit
 def advance_loop(
     state: np.ndarray,
     constants: LoopConstants,
@@ -247,19 +250,23 @@ def advance_loop(
     sent: np.ndarray,
     channel_costs: np.ndarray,
 ) -> None:
-    """One sampling period of every follower in the state row; follower i's cost is its
-    distance to its containment target ‖σ_i - σ_d,i‖ (eq. 8)."""
+    """One sampling period of every follower in the state row: one RK4 step of plant (eqs. 2
+    and 4) and adaptation laws (eqs. 20-21) with the held controls, then what an event would
+    send and each follower's features at t_k + h. Follower i's cost is its distance to its
+    containment target ‖σ_i - σ_d,i‖ (eq. 8)."""
     table = follower_table(state)
-    y, samples, features, errors, norms = closed_loop_step(
-        step_index * h, h, table[:, PLANT], held, episode_model(state, constants)
-    )
-    table[:, PLANT] = y
-    table[:, SAMPLE] = samples
-    table[:, FEATURES] = features
-    table[:, NORMS] = norms
-    channel_costs[:] = errors
-    note_outside_followers(table, errors, step_index + 1)
-    note_peak_rate(state, norms[:, 1].max(), step_index + 1)
+    model = episode_model(state, constants)
+    t = step_index * h
+    plant = table[:, PLANT]
+    plant[:, :] = integrate_loop(t, np.ascontiguousarray(plant), h, (held, model))
+    samples = table[:, SAMPLE]
+    write_event_samples(plant, model, samples)
+    write_agent_features(t + h, plant, samples, held, model, table[:, FEATURES])
+    write_norms(table)
+    for i in range(table.shape[0]):
+        channel_costs[i] = containment_error(plant[i, 0:3], model.targets[i])
+    note_outside_followers(table, channel_costs, step_index + 1)
+    note_peak_rate(state, table[:, NORMS.start + 1].max(), step_index + 1)
 
 
 @jit
@@ -268,8 +275,10 @@ def loop_failure(state: np.ndarray, constants: LoopConstants) -> int:
     table = follower_table(state)
     if not np.isfinite(table[:, PLANT].sum() + table[:, SAMPLE].sum()):
         return NON_FINITE
-    if not np.all(table[:, NORMS] <= constants.limits):
-        return DIVERGED
+    limits = constants.limits
+    for i in range(table.shape[0]):
+        if not (table[i, NORMS.start] <= limits[0] and table[i, NORMS.start + 1] <= limits[1]):
+            return DIVERGED
     return 0
 
 

@@ -13,9 +13,10 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import matvec, matvec_transposed
-from etsc_envs.core.rotations import cross, mrp_kinematics_matrix
+from etsc_envs.core.rotations import mrp_kinematics
+from etsc_envs.core.vec3 import Vec3
 
 ClusterModel = namedtuple(
     "ClusterModel",
@@ -42,7 +43,7 @@ ClusterModel = namedtuple(
 
 
 @jit
-def disturbance(t: float, follower: int, model: ClusterModel) -> np.ndarray:
+def disturbance(t: float, follower: int, model: ClusterModel) -> Vec3:
     """d_i = d_li + d_uni of eqs. (66)-(68), the disturbance of the Euler-Lagrange form (5).
 
     d_uni = (1/5) [d_li(1) sin(t/12), d_li(2) cos(t/15), d_li(3) sin(t/10) cos(t/15)].
@@ -50,45 +51,52 @@ def disturbance(t: float, follower: int, model: ClusterModel) -> np.ndarray:
     constant = model.constant_disturbance[follower]
     rates = model.periodic_rates
     phase = model.disturbance_phase[follower]
-    periodic = np.empty(3)
-    periodic[0] = constant[0] * np.sin(rates[0] * t + phase[0])
-    periodic[1] = constant[1] * np.cos(rates[1] * t + phase[1])
-    periodic[2] = constant[2] * np.sin(rates[2] * t + phase[2]) * np.cos(rates[3] * t + phase[3])
-    return constant + model.periodic_fraction * periodic
+    fraction = model.periodic_fraction
+    first = constant[0] * np.sin(rates[0] * t + phase[0])
+    second = constant[1] * np.cos(rates[1] * t + phase[1])
+    third = constant[2] * np.sin(rates[2] * t + phase[2]) * np.cos(rates[3] * t + phase[3])
+    return (
+        constant[0] + fraction * first,
+        constant[1] + fraction * second,
+        constant[2] + fraction * third,
+    )
 
 
 @jit
-def attitude_rates(sigma: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """σ̇_i = G(σ_i) ω_i of eq. (2) for every follower (N×3 in, N×3 out)."""
-    rates = np.empty_like(sigma)
-    for i in range(sigma.shape[0]):
-        rates[i] = matvec(mrp_kinematics_matrix(sigma[i]), omega[i])
-    return rates
+def attitude_rate(sigma, omega) -> Vec3:
+    """σ̇_i = G(σ_i) ω_i of eq. (2)."""
+    return vec3.matvec_from_zero(mrp_kinematics(sigma), omega)
+
+
+@jit
+def write_attitude_rates(y: np.ndarray, out: np.ndarray) -> None:
+    """Write σ̇_i of eq. (2) of every follower of the N×13 state ``y`` into row i of ``out``."""
+    for i in range(y.shape[0]):
+        vec3.store(out[i], attitude_rate(y[i, 0:3], y[i, 3:6]))
 
 
 @jit
 def body_acceleration(
     t: float,
     follower: int,
-    sigma: np.ndarray,
-    omega: np.ndarray,
-    control: np.ndarray,
+    sigma,
+    omega,
+    control,
     model: ClusterModel,
-) -> np.ndarray:
+) -> Vec3:
     """ω̇_i from eq. (4), J_i ω̇_i = -ω_i^× J_i ω_i + τ_i + τ_di, where the body torques are
     τ_i = G(σ_i)ᵀ u_i and τ_di = G(σ_i)ᵀ d_i (u_i = G⁻ᵀτ_i and d_i = G⁻ᵀτ_di in eq. 5)."""
-    torque = matvec_transposed(
-        mrp_kinematics_matrix(sigma), control + disturbance(t, follower, model)
+    torque = vec3.matvec_transposed_from_zero(
+        mrp_kinematics(sigma), vec3.add(control, disturbance(t, follower, model))
     )
-    momentum = matvec(model.inertia[follower], omega)
-    return matvec(model.inertia_inverse[follower], torque - cross(omega, momentum))
+    momentum = vec3.matvec_from_zero(model.inertia[follower], omega)
+    return vec3.matvec_from_zero(
+        model.inertia_inverse[follower], vec3.subtract(torque, vec3.cross(omega, momentum))
+    )
 
 
 @jit
-def containment_errors(sigma: np.ndarray, model: ClusterModel) -> np.ndarray:
-    """‖σ_i - σ_d,i‖ for every follower: the distance to its containment target (eq. 8)."""
-    errors = np.empty(sigma.shape[0])
-    for i in range(sigma.shape[0]):
-        difference = sigma[i] - model.targets[i]
-        errors[i] = np.sqrt(difference @ difference)
-    return errors
+def containment_error(sigma, target) -> float:
+    """‖σ_i - σ_d,i‖: a follower's distance to its containment target (eq. 8)."""
+    difference = vec3.subtract(sigma, target)
+    return np.sqrt(vec3.dot(difference, difference))

@@ -30,14 +30,14 @@ from etsc_envs.cluster.closed_loop import (
     SAMPLE,
     SAMPLE_WIDTH,
     LoopConstants,
-    agent_features,
     episode_model,
-    event_samples,
     follower_signals,
     follower_table,
     note_outside_followers,
     note_peak_rate,
     state_width,
+    write_agent_features,
+    write_event_samples,
 )
 from etsc_envs.cluster.dynamics import ClusterModel
 from etsc_envs.cluster.params import ClusterContainmentParams, replace_params
@@ -237,9 +237,9 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
         y[:, 6:12] = np.array(p.initial_parameter_estimate, dtype=float)
         y[:, 12] = p.initial_switching_gain
         model = self.model
-        samples = event_samples(y, model)
-        followers[:, SAMPLE] = samples
-        followers[:, FEATURES] = agent_features(0.0, y, samples, samples, model)
+        samples = followers[:, SAMPLE]
+        write_event_samples(y, model, samples)
+        write_agent_features(0.0, y, samples, samples, model, followers[:, FEATURES])
         followers[:, NORMS] = np.stack(
             [np.linalg.norm(attitudes, axis=1), np.linalg.norm(rates, axis=1)], axis=1
         )

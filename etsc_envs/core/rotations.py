@@ -261,24 +261,30 @@ def mrp_to_quat(sigma: np.ndarray) -> np.ndarray:
 
 
 @jit
-def mrp_kinematics_matrix(sigma: np.ndarray) -> np.ndarray:
-    """``G(σ) = ½[(1 - σᵀσ)/2 I + σ^× + σσᵀ]`` so that ``σ̇ = G(σ) ω``.
+def mrp_kinematics(sigma) -> vec3.Mat3:
+    """The rows of ``G(σ) = ½[(1 - σᵀσ)/2 I + σ^× + σσᵀ]``, so that ``σ̇ = G(σ) ω``.
 
     Written entry by entry (it sits on the hot path of MRP-based problems).
     """
     x, y, z = sigma[0], sigma[1], sigma[2]
     diagonal = 0.5 * (1.0 - (x * x + y * y + z * z))
-    out = np.empty((3, 3))
-    out[0, 0] = 0.5 * (diagonal + x * x)
-    out[0, 1] = 0.5 * (-z + x * y)
-    out[0, 2] = 0.5 * (y + x * z)
-    out[1, 0] = 0.5 * (z + y * x)
-    out[1, 1] = 0.5 * (diagonal + y * y)
-    out[1, 2] = 0.5 * (-x + y * z)
-    out[2, 0] = 0.5 * (-y + z * x)
-    out[2, 1] = 0.5 * (x + z * y)
-    out[2, 2] = 0.5 * (diagonal + z * z)
-    return out
+    return (
+        (0.5 * (diagonal + x * x), 0.5 * (-z + x * y), 0.5 * (y + x * z)),
+        (0.5 * (z + y * x), 0.5 * (diagonal + y * y), 0.5 * (-x + y * z)),
+        (0.5 * (-y + z * x), 0.5 * (x + z * y), 0.5 * (diagonal + z * z)),
+    )
+
+
+@jit
+def mrp_kinematics_matrix(sigma: np.ndarray) -> np.ndarray:
+    """``G(σ)`` of :func:`mrp_kinematics` as a 3×3 array."""
+    return vec3.to_matrix(mrp_kinematics(sigma))
+
+
+@jit
+def mrp_inverse_scale(sigma) -> float:
+    """``16 / (1 + σᵀσ)²``, the factor of :func:`mrp_kinematics_matrix_inverse`."""
+    return 16.0 / (1.0 + sigma[0] ** 2 + sigma[1] ** 2 + sigma[2] ** 2) ** 2
 
 
 @jit
@@ -288,26 +294,38 @@ def mrp_kinematics_matrix_inverse(sigma: np.ndarray) -> np.ndarray:
     ``4 G(σ)`` is ``(1 + σᵀσ)`` times a rotation matrix, hence the closed form; it exists for
     every σ.
     """
-    scale = 16.0 / (1.0 + sigma[0] ** 2 + sigma[1] ** 2 + sigma[2] ** 2) ** 2
-    return scale * np.ascontiguousarray(mrp_kinematics_matrix(sigma).T)
+    return mrp_inverse_scale(sigma) * np.ascontiguousarray(mrp_kinematics_matrix(sigma).T)
+
+
+@jit
+def mrp_kinematics_rate(sigma, sigma_dot) -> vec3.Mat3:
+    """The rows of the time derivative ``Ġ = ½[-(σᵀσ̇) I + σ̇^× + σ̇σᵀ + σσ̇ᵀ]`` of ``G(σ)``
+    along ``σ̇``."""
+    s, d = sigma, sigma_dot
+    half_projection = 0.5 * (s[0] * d[0] + s[1] * d[1] + s[2] * d[2])
+    return (
+        (
+            0.5 * (d[0] * s[0] + s[0] * d[0]) - half_projection,
+            0.5 * (d[0] * s[1] + s[0] * d[1]) - 0.5 * d[2],
+            0.5 * (d[0] * s[2] + s[0] * d[2]) + 0.5 * d[1],
+        ),
+        (
+            0.5 * (d[1] * s[0] + s[1] * d[0]) + 0.5 * d[2],
+            0.5 * (d[1] * s[1] + s[1] * d[1]) - half_projection,
+            0.5 * (d[1] * s[2] + s[1] * d[2]) - 0.5 * d[0],
+        ),
+        (
+            0.5 * (d[2] * s[0] + s[2] * d[0]) - 0.5 * d[1],
+            0.5 * (d[2] * s[1] + s[2] * d[1]) + 0.5 * d[0],
+            0.5 * (d[2] * s[2] + s[2] * d[2]) - half_projection,
+        ),
+    )
 
 
 @jit
 def mrp_kinematics_matrix_rate(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
-    """Time derivative ``Ġ = ½[-(σᵀσ̇) I + σ̇^× + σ̇σᵀ + σσ̇ᵀ]`` of ``G(σ)`` along ``σ̇``."""
-    projection = sigma[0] * sigma_dot[0] + sigma[1] * sigma_dot[1] + sigma[2] * sigma_dot[2]
-    out = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = 0.5 * (sigma_dot[i] * sigma[j] + sigma[i] * sigma_dot[j])
-        out[i, i] -= 0.5 * projection
-    out[0, 1] -= 0.5 * sigma_dot[2]
-    out[0, 2] += 0.5 * sigma_dot[1]
-    out[1, 0] += 0.5 * sigma_dot[2]
-    out[1, 2] -= 0.5 * sigma_dot[0]
-    out[2, 0] -= 0.5 * sigma_dot[1]
-    out[2, 1] += 0.5 * sigma_dot[0]
-    return out
+    """``Ġ`` of :func:`mrp_kinematics_rate` as a 3×3 array."""
+    return vec3.to_matrix(mrp_kinematics_rate(sigma, sigma_dot))
 
 
 # --------------------------------------------------------------------------- SE(3) operators

@@ -21,6 +21,8 @@ from etsc_envs.core.linalg import fused_column_dot3, fused_multiply_add, fused_r
 
 Vec3 = tuple[float, float, float]
 """A 3-vector as returned by the helpers of this module."""
+Mat3 = tuple[Vec3, Vec3, Vec3]
+"""A 3×3 matrix as the tuple of its rows."""
 
 
 @jit
@@ -42,6 +44,15 @@ def to_array(vector) -> np.ndarray:
     """A new float64 array holding the three entries of ``vector``."""
     out = np.empty(3)
     store(out, vector)
+    return out
+
+
+@jit
+def to_matrix(rows) -> np.ndarray:
+    """A new 3×3 float64 array holding the rows ``rows`` (a :data:`Mat3` or an array)."""
+    out = np.empty((3, 3))
+    for i in range(3):
+        store(out[i], rows[i])
     return out
 
 
@@ -156,4 +167,41 @@ def solve(matrix: np.ndarray, rhs) -> Vec3:
         fused_multiply_add(c20, r2, fused_multiply_add(c00, r0, c10 * r1)) / det,
         fused_multiply_add(c21, r2, fused_multiply_add(c01, r0, c11 * r1)) / det,
         fused_multiply_add(c22, r2, fused_multiply_add(c02, r0, c12 * r1)) / det,
+    )
+
+
+@jit
+def column_dot_from_zero(rows, column: int, vector) -> float:
+    """Entry ``column`` of ``matrix.T @ vector`` for a matrix of three rows ``rows`` (tuples or
+    array rows, of any length), summed from zero in row order without fused multiply-adds:
+    the value the loop of :func:`etsc_envs.core.linalg.matvec_transposed` returns."""
+    return (
+        0.0
+        + rows[0][column] * vector[0]
+        + rows[1][column] * vector[1]
+        + rows[2][column] * vector[2]
+    )
+
+
+@jit
+def matvec_from_zero(rows, vector) -> Vec3:
+    """``matrix @ vector`` for a 3×3 matrix given by its rows (a :data:`Mat3` or an array),
+    each entry summed from zero in index order without fused multiply-adds: the value the loop
+    of :func:`etsc_envs.core.linalg.matvec` returns."""
+    return (
+        0.0 + rows[0][0] * vector[0] + rows[0][1] * vector[1] + rows[0][2] * vector[2],
+        0.0 + rows[1][0] * vector[0] + rows[1][1] * vector[1] + rows[1][2] * vector[2],
+        0.0 + rows[2][0] * vector[0] + rows[2][1] * vector[1] + rows[2][2] * vector[2],
+    )
+
+
+@jit
+def matvec_transposed_from_zero(rows, vector) -> Vec3:
+    """``matrix.T @ vector`` for a 3×3 matrix given by its rows, by
+    :func:`column_dot_from_zero`: the value the loop of
+    :func:`etsc_envs.core.linalg.matvec_transposed` returns."""
+    return (
+        column_dot_from_zero(rows, 0, vector),
+        column_dot_from_zero(rows, 1, vector),
+        column_dot_from_zero(rows, 2, vector),
     )
