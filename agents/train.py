@@ -601,6 +601,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, help="override seed")
     parser.add_argument("--out", type=Path, help="override out_dir")
     parser.add_argument(
+        "--init-from",
+        type=Path,
+        metavar="MODEL",
+        help="override init_from (e.g. each seed's run of a curriculum's previous stage)",
+    )
+    parser.add_argument(
         "--resume", action="store_true", help="continue from the newest checkpoint of out_dir"
     )
     return parser
@@ -614,6 +620,7 @@ def main(argv: list[str] | None = None) -> int:
         "total_timesteps": args.timesteps,
         "seed": args.seed,
         "out_dir": None if args.out is None else str(args.out),
+        "init_from": None if args.init_from is None else str(args.init_from),
     }
     try:
         config = load_config(

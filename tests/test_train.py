@@ -178,7 +178,10 @@ def test_resume_continues_from_the_newest_checkpoint(tmp_path: Path) -> None:
     assert summary["timesteps"] < 320 + 128, "resuming does not start the count again"
 
 
-def test_init_from_starts_from_an_earlier_models_weights_and_statistics(tmp_path: Path) -> None:
+@pytest.mark.parametrize("given_on", ["config", "command line"])
+def test_init_from_starts_from_an_earlier_models_weights_and_statistics(
+    tmp_path: Path, given_on: str
+) -> None:
     import pickle
 
     import numpy as np
@@ -188,9 +191,12 @@ def test_init_from_starts_from_an_earlier_models_weights_and_statistics(tmp_path
     first = tmp_path / "first"
     assert main(["--config", str(write_config(tiny_config(first), tmp_path))]) == 0
     second = tmp_path / "second"
-    config = tiny_config(second) | {"init_from": str(first / MODEL_FILE), "total_timesteps": 64}
+    config = tiny_config(second) | {"total_timesteps": 64}
+    extra = ["--init-from", str(first / MODEL_FILE)]
+    if given_on == "config":
+        config["init_from"], extra = str(first / MODEL_FILE), []
     config["hyperparameters"]["learning_rate"] = 0.0  # keep the weights as loaded
-    assert main(["--config", str(write_config(config, tmp_path))]) == 0
+    assert main(["--config", str(write_config(config, tmp_path)), *extra]) == 0
     before = stable_baselines3.PPO.load(first / MODEL_FILE, device="cpu").policy.state_dict()
     after = stable_baselines3.PPO.load(second / MODEL_FILE, device="cpu").policy.state_dict()
     for name, weights in before.items():
