@@ -143,7 +143,8 @@ def plot(result: dict[str, Any], path: Path) -> None:
             axes[row, column].axhline(1.0, color="k", linewidth=0.8, linestyle=":")
             axes[row, column].set_yscale("log")
             axes[row, column].grid(True, which="major", alpha=0.3)
-    axes[0, 0].axhline(result["cost_tolerance"], color="k", linewidth=0.8, linestyle="--")
+    for column in range(2):
+        axes[0, column].axhline(result["cost_tolerance"], color="k", linewidth=0.8, linestyle="--")
     axes[1, 0].set_xlabel("sampling instants simulated for training")
     axes[1, 1].set_xlabel("training wall time (s)")
     figure.legend(loc="lower center", ncol=4, frameon=False)
