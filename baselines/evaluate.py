@@ -20,7 +20,7 @@ from typing import Any
 
 import gymnasium as gym
 
-from baselines.batch import run_batch
+from baselines.batch import process_count, run_batch, run_batch_in_processes
 from baselines.cli import (
     POLICY_CHOICES,
     episode_setup,
@@ -47,6 +47,7 @@ def evaluate(
     set_size: int = DEFAULT_SET_SIZE,
     plot_dir: str | Path | None = None,
     progress: bool = False,
+    processes: int | None = None,
 ) -> dict[str, Any]:
     """Run ``policy`` on a scenario set, or on ``episodes`` ad-hoc episodes (seeds ``seed,
     seed+1, ...``), and return the design page's JSON with the protocol's aggregates.
@@ -56,6 +57,9 @@ def evaluate(
             when given, ``episodes`` and ``seed`` are not used.
         set_size: scenarios of the validation or test set.
         plot_dir: write one figure per episode (runs the episodes one by one).
+        processes: worker processes sharing a batch
+            (:func:`baselines.batch.run_batch_in_processes`); ``None`` takes
+            :func:`baselines.batch.process_count`'s, 1 runs it in this process.
 
     Several episodes without plots run at once in the id's native vector env
     (:func:`baselines.batch.run_batch`); the records equal the one-by-one runs'.
@@ -78,14 +82,23 @@ def evaluate(
     trigger = setup.make_policy(policy, policy_args)
     if len(seeds) > 1 and plot_dir is None:
         setup.env.close()
-        records = run_batch(
-            env_id,
-            trigger,
-            seeds,
-            env_args,
-            progress=progress,
-            description=f"{policy} on {len(seeds)} scenarios",
-        )
+        processes = process_count(len(seeds)) if processes is None else processes
+        description = f"{policy} on {len(seeds)} scenarios"
+        if processes > 1:
+            records = run_batch_in_processes(
+                env_id,
+                policy,
+                policy_args,
+                seeds,
+                env_args,
+                processes=processes,
+                progress=progress,
+                description=description,
+            )
+        else:
+            records = run_batch(
+                env_id, trigger, seeds, env_args, progress=progress, description=description
+            )
     else:
         records = []
         for index, episode_seed in enumerate(seeds):

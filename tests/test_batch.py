@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from baselines.batch import run_batch
+from baselines.batch import run_batch, run_batch_in_processes
 from baselines.cli import episode_setup
 
 SHORT_HORIZONS = {
@@ -38,12 +38,16 @@ def single_records(
 
 
 def batch_records(
-    env_id: str, spec: str, policy_args: dict[str, Any], env_args: dict[str, Any]
+    env_id: str,
+    spec: str,
+    policy_args: dict[str, Any],
+    env_args: dict[str, Any],
+    seeds: tuple[int, ...] = SEEDS,
 ) -> list[dict[str, Any]]:
     setup = episode_setup(env_id, env_args)
     policy = setup.make_policy(spec, policy_args)
     setup.env.close()
-    return run_batch(env_id, policy, SEEDS, env_args)
+    return run_batch(env_id, policy, seeds, env_args)
 
 
 def distinct(record: dict[str, Any]) -> str:
@@ -112,3 +116,29 @@ def test_a_scenario_that_fails_early_keeps_its_own_record() -> None:
     assert len({record["steps"] for record in single}) == len(SEEDS), "they fail apart"
     for one, other in zip(single, batch, strict=True):
         assert_same_record(one, other)
+
+
+@pytest.mark.parametrize(
+    ("env_id", "spec"),
+    [
+        ("etsc/OrbitAttitudeTracking-v0", "paper"),
+        ("etsc/ClusterContainment-v0", "paper"),
+        ("etsc/AttitudeTracking-v0", f"sb3:{MODEL}"),
+    ],
+)
+def test_worker_processes_give_the_records_of_one_process(env_id: str, spec: str) -> None:
+    if spec.startswith("sb3:"):
+        pytest.importorskip("stable_baselines3")
+    env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
+    seeds = (*SEEDS, 2_000_003, 2_000_004)
+    together = batch_records(env_id, spec, {}, env_args, seeds)
+    apart = run_batch_in_processes(env_id, spec, {}, seeds, env_args, processes=2)
+    assert [record["seed"] for record in apart] == list(seeds)
+    for one, other in zip(together, apart, strict=True):
+        assert_same_record(one, other)
+
+
+@pytest.mark.parametrize("processes", [0, -1, 1.5, True])
+def test_a_bad_process_count_names_itself(processes: Any) -> None:
+    with pytest.raises(ValueError, match="processes"):
+        run_batch_in_processes("etsc/AttitudeTracking-v0", "paper", {}, SEEDS, processes=processes)
