@@ -276,16 +276,21 @@ def _draw_paper_scenario(axes: plt.Axes, result: dict[str, Any]) -> None:
 
 
 def _log_axes(axes: plt.Axes, costs: list[float]) -> None:
-    """Log transmissions; log cost (symlog when a cost is 0), major labels only."""
+    """Log transmissions; log cost (symlog when a cost is 0), major labels only — and the
+    cost's minor ticks too when its costs lie within one decade (no major tick to label)."""
     axes.set_xscale("log")
     positive = [cost for cost in costs if cost > 0]
+    within_a_decade = bool(positive) and max(positive) < 10.0 * min(positive)
     if positive and len(positive) == len(costs):
         axes.set_yscale("log")
     else:  # a zero cost (paper 003 inside its shell) has no place on a log axis
         axes.set_yscale("symlog", linthresh=min(positive, default=1.0))
         axes.set_ylim(bottom=0.0)
-    for axis in (axes.xaxis, axes.yaxis):
-        axis.set_minor_formatter(ticker.NullFormatter())
+        within_a_decade = False
+    axes.xaxis.set_minor_formatter(ticker.NullFormatter())
+    axes.yaxis.set_minor_formatter(
+        ticker.FormatStrFormatter("%.3g") if within_a_decade else ticker.NullFormatter()
+    )
     axes.xaxis.set_major_locator(ticker.LogLocator(numticks=6))
     axes.grid(True, which="both", alpha=0.3)
     axes.set_xlabel("transmissions per episode")

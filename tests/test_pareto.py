@@ -88,3 +88,17 @@ def test_the_pettingzoo_cluster_shares_its_central_forms_baseline_points(tmp_pat
         assert curves[0][name] == curves[1][name] == curves[2][name]
     with pytest.raises(SystemExit):
         main(["etsc/AttitudeTracking-v0", *argv, *reuse])
+
+
+def test_costs_within_one_decade_still_get_labelled_ticks() -> None:
+    import matplotlib.pyplot as plt
+
+    from agents.pareto import _log_axes
+
+    figure, axes = plt.subplots()
+    axes.plot([10, 100, 1000], [3.1, 3.4, 4.2])
+    _log_axes(axes, [3.1, 3.4, 4.2])
+    figure.canvas.draw()
+    labels = [tick.get_text() for tick in axes.get_yticklabels(minor=True) if tick.get_text()]
+    plt.close(figure)
+    assert labels, "a cost axis inside one decade needs labelled minor ticks"
