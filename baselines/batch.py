@@ -42,6 +42,7 @@ from tqdm import tqdm
 
 import etsc_envs
 from etsc_envs.core.multi_agent import agent_observation_index
+from etsc_envs.core.vector_env import available_cores
 
 PROGRESS_EVERY = 1000
 """Sampling instants between progress-bar updates."""
@@ -53,14 +54,7 @@ ROWS_PER_PROCESS_MIN = 16
 def process_count(n_scenarios: int) -> int:
     """Worker processes worth starting for a set of ``n_scenarios``: one per available core,
     at most one per :data:`ROWS_PER_PROCESS_MIN` scenarios."""
-    return max(1, min(len(_cores()), n_scenarios // ROWS_PER_PROCESS_MIN))
-
-
-def _cores() -> list[int]:
-    """The cores this process may run on."""
-    if hasattr(os, "sched_getaffinity"):
-        return sorted(os.sched_getaffinity(0))
-    return list(range(os.cpu_count() or 1))
+    return max(1, min(len(available_cores()), n_scenarios // ROWS_PER_PROCESS_MIN))
 
 
 def _vector_env(env_id: str, num_envs: int, env_args: dict[str, Any]) -> Any:
@@ -125,7 +119,7 @@ def run_batch_in_processes(
     if isinstance(processes, bool) or not isinstance(processes, int) or processes < 1:
         raise ValueError(f"processes must be an integer >= 1, got {processes!r}")
     parts = [part.tolist() for part in np.array_split(np.array(seeds), processes) if part.size]
-    cores = _cores()
+    cores = available_cores()
     work = (env_id, policy_spec, dict(policy_args), dict(env_args or {}), description)
     with ProcessPoolExecutor(len(parts), mp_context=multiprocessing.get_context("spawn")) as pool:
         futures = [

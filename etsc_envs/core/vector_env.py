@@ -48,10 +48,16 @@ def _autoreset_mode(value: AutoresetMode | str) -> AutoresetMode:
     raise ValueError(f"autoreset_mode must be one of {allowed}, got {value!r}")
 
 
+def available_cores() -> list[int]:
+    """The cores this process may run on (its affinity where the platform has one)."""
+    if hasattr(os, "sched_getaffinity"):
+        return sorted(os.sched_getaffinity(0))
+    return list(range(os.cpu_count() or 1))
+
+
 def _worker_count(num_envs: int) -> int:
     """Threads that step a batch of ``num_envs`` rows."""
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return max(1, min(cores or 1, num_envs // ROWS_PER_THREAD_MIN))
+    return max(1, min(len(available_cores()), num_envs // ROWS_PER_THREAD_MIN))
 
 
 def _row_chunks(num_envs: int, workers: int) -> list[tuple[int, int]]:
