@@ -6,9 +6,11 @@ threshold scaled by f. The wrapper runs the interval on the unchanged env and re
 observation of the next decision instant. A hold's instants run in one compiled call
 (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`) when only ``gym.make``'s
 order-enforcing and passive-checker wrappers lie between the wrapper and the loop env (neither
-acts on a step once the env is reset and its first step checked); under any other wrapper
-(``TimeLimit``, say) every instant goes through ``env.step``. The paper's rule decides each
-instant in Python, one ``env.step`` each. Its reward is the interval's rewards discounted
+acts on a step once the env is reset and its first step checked), and so does a "follow the
+paper" interval, whose rule's compiled kernel decides each instant inside the loop
+(:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_rule_interval`); under any other wrapper
+(``TimeLimit``, say) every instant goes through ``env.step``, the rule deciding in Python. Its
+reward is the interval's rewards discounted
 within it, ``sum_i gamma**i * r_i`` over the ``n`` instants it ran, and ``info["elapsed_steps"]
 = n``, so that an algorithm discounting the next decision by ``gamma**n`` keeps the meaning of
 the per-instant return: Stable-Baselines3 discounts every decision by one constant ``gamma``
@@ -126,6 +128,29 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         given = int(given[0])
         obs = self._observation[None]
         chosen = self.schedule.shielded(np.array([given]), obs)
+        following = int(chosen[0]) - self.decisions.n_holds
+        if following >= 0 and self._loop is not None:
+            observation, total, terminated, truncated, info, steps = self._loop.run_rule_interval(
+                self.schedule.triggers[following], int(self.decisions.hold_steps[-1]), self.gamma
+            )
+        else:
+            observation, total, terminated, truncated, info, steps = self._run_schedule(chosen)
+        self._observation = observation
+        info = {
+            **info,
+            "elapsed_steps": steps,
+            "action": int(chosen[0]),
+            "shielded": bool(chosen[0] != given),
+        }
+        return observation, total, terminated, truncated, info
+
+    def _run_schedule(
+        self, chosen: np.ndarray
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
+        """The interval of action ``chosen`` (one row) instant by instant through
+        :class:`~baselines.self_triggered.IntervalSchedule`, its holds in compiled calls where
+        :func:`interval_env` allows: :meth:`_run`'s return over the whole interval."""
+        obs = self._observation[None]
         state = self.schedule.start(chosen)
         total, steps = 0.0, 0
         while True:
@@ -139,15 +164,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             state = state + np.array([0, held])
             obs = observation[None]
             if terminated or truncated or self.schedule.interval_over(obs, state)[0]:
-                break
-        self._observation = observation
-        info = {
-            **info,
-            "elapsed_steps": steps,
-            "action": int(chosen[0]),
-            "shielded": bool(chosen[0] != given),
-        }
-        return observation, total, terminated, truncated, info
+                return observation, total, terminated, truncated, info, steps
 
     def _run(
         self, first_action: np.ndarray, instants: int

@@ -43,6 +43,7 @@ from tqdm import tqdm
 import etsc_envs
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.vector_env import available_cores
+from etsc_envs.triggers.base import RuleTrigger
 
 PROGRESS_EVERY = 1000
 """Sampling instants between progress-bar updates."""
@@ -164,48 +165,16 @@ def _run(
     agent_index = agent_observation_index(loop) if multi_agent else None
     n_agents = loop.n_channels if multi_agent else 1
 
-    def policy_input(observations: np.ndarray) -> np.ndarray:
-        if agent_index is None:
-            return observations
-        return observations[:, agent_index].reshape(rows * n_agents, -1)
-
     started = time.perf_counter()
     observations, _ = vector_env.reset(seed=seeds)
     returns = np.zeros((rows, n_agents))
-    running = np.ones(rows, dtype=bool)
-    ended_metrics: list[dict[str, Any] | None] = [None] * rows
-    state, episode_start = None, np.ones(rows * n_agents, dtype=bool)
-    not_started = np.zeros(rows * n_agents, dtype=bool)
-    bar = tqdm(
-        total=loop.n_steps,
-        disable=not progress,
-        desc=description,
-        unit="step",
-        leave=False,
-        mininterval=0.5,
-    )
-    steps = 0
-    while running.any():
-        actions, state = policy.predict(
-            policy_input(observations),
-            state=state,
-            episode_start=episode_start,
-            deterministic=True,
+    if isinstance(policy, RuleTrigger):
+        _run_rule(vector_env, policy, returns, multi_agent, progress, description)
+        ended_metrics = [env.episode_metrics() for env in vector_env.envs]
+    else:
+        ended_metrics = _run_predict(
+            vector_env, policy, observations, returns, agent_index, progress, description
         )
-        episode_start = not_started
-        actions = np.asarray(actions).reshape(rows, -1) if multi_agent else actions
-        observations, rewards, terminated, truncated, _ = vector_env.step(actions)
-        if multi_agent:
-            returns[running] += vector_env.channel_rewards[running]
-        else:
-            returns[running, 0] += rewards[running]
-        for row in np.flatnonzero(running & (terminated | truncated)):
-            ended_metrics[row] = vector_env.envs[row].episode_metrics()
-            running[row] = False
-        steps += 1
-        if steps % PROGRESS_EVERY == 0:
-            bar.update(PROGRESS_EVERY)
-    bar.close()
     wall_time_s = (time.perf_counter() - started) / rows
     names = tuple(getattr(loop, "agent_names", ()))
     records = []
@@ -225,3 +194,94 @@ def _run(
             }
         records.append(record)
     return records
+
+
+def _progress_bar(total: int, shown: bool, description: str) -> tqdm:
+    """The progress bar over a batch's sampling instants."""
+    return tqdm(
+        total=total,
+        disable=not shown,
+        desc=description,
+        unit="step",
+        leave=False,
+        mininterval=0.5,
+    )
+
+
+def _run_rule(
+    vector_env: Any,
+    trigger: RuleTrigger,
+    returns: np.ndarray,
+    multi_agent: bool,
+    progress: bool,
+    description: str,
+) -> None:
+    """Every row's whole episode under a paper's rule, :data:`PROGRESS_EVERY` instants per
+    compiled call (:meth:`~etsc_envs.core.vector_env.EventTriggeredVectorEnv.run_rule`): the
+    decisions and records of the per-instant loop of :func:`_run`, without its Python call per
+    instant. Adds each row's return (per agent for a PettingZoo id) to ``returns``."""
+    loop = vector_env.envs[0]
+    if multi_agent:  # the agents' rule, read from the loop's joint observation
+        trigger = trigger.for_observations(
+            loop.observation_space, loop.action_space, loop.observation_names
+        )
+    totals = np.zeros(vector_env.num_envs)
+    channel_totals = np.zeros((vector_env.num_envs, loop.n_channels))
+    with _progress_bar(loop.n_steps, progress, description) as bar:
+        while True:
+            steps_run = vector_env.run_rule(trigger, PROGRESS_EVERY, totals, channel_totals)
+            bar.update(int(steps_run.max()))
+            if not steps_run.any():
+                break
+    if multi_agent:
+        returns += channel_totals
+    else:
+        returns[:, 0] += totals
+
+
+def _run_predict(
+    vector_env: Any,
+    policy: Any,
+    observations: np.ndarray,
+    returns: np.ndarray,
+    agent_index: np.ndarray | None,
+    progress: bool,
+    description: str,
+) -> list[dict[str, Any]]:
+    """Every row's episode from ``observations`` (just after the reset), one batched
+    ``predict`` per instant (for a PettingZoo id, with ``agent_index`` gathering each agent's
+    observation); adds each row's return (per agent for a PettingZoo id) to ``returns`` and
+    returns each row's episode metrics, taken at the step that ends it."""
+    rows = vector_env.num_envs
+    loop = vector_env.envs[0]
+    multi_agent = agent_index is not None
+    n_agents = returns.shape[1]
+    running = np.ones(rows, dtype=bool)
+    ended_metrics: list[dict[str, Any]] = [{} for _ in range(rows)]
+    state, episode_start = None, np.ones(rows * n_agents, dtype=bool)
+    not_started = np.zeros(rows * n_agents, dtype=bool)
+    steps = 0
+    with _progress_bar(loop.n_steps, progress, description) as bar:
+        while running.any():
+            policy_input = (
+                observations[:, agent_index].reshape(rows * n_agents, -1)
+                if multi_agent
+                else observations
+            )
+            actions, state = policy.predict(
+                policy_input, state=state, episode_start=episode_start, deterministic=True
+            )
+            episode_start = not_started
+            actions = np.asarray(actions).reshape(rows, -1) if multi_agent else actions
+            observations, rewards, terminated, truncated, _ = vector_env.step(actions)
+            if multi_agent:
+                returns[running] += vector_env.channel_rewards[running]
+            else:
+                returns[running, 0] += rewards[running]
+            for row in np.flatnonzero(running & (terminated | truncated)):
+                ended_metrics[row] = vector_env.envs[row].episode_metrics()
+                running[row] = False
+            steps += 1
+            if steps % PROGRESS_EVERY == 0:
+                bar.update(PROGRESS_EVERY)
+    return ended_metrics

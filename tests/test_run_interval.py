@@ -1,5 +1,6 @@
-"""``EventTriggeredEnv.run_interval``: one compiled call over several sampling instants equals
-the same actions given to ``step`` one instant at a time, bit for bit (observation, rewards and
+"""``EventTriggeredEnv.run_interval`` and ``run_rule_interval``: one compiled call over several
+sampling instants equals the same actions (or the paper rule's decisions) given to ``step`` one
+instant at a time, bit for bit (observation, rewards and
 their discounted sum, termination, info and episode metrics, every loop array), for every
 Gymnasium id, also across a failure and up to the horizon; bad arguments raise."""
 
@@ -12,6 +13,7 @@ import numpy as np
 import pytest
 
 from etsc_envs import ENV_IDS
+from etsc_envs.triggers import PAPER_THRESHOLDS, PAPER_TRIGGERS, PeriodicPolicy
 
 SEED = 5
 HORIZONS_S = {
@@ -149,3 +151,87 @@ def test_an_interval_before_reset_asks_for_one():
     env = gym.make("etsc/AttitudeTracking-v0", horizon_s=0.1).unwrapped
     with pytest.raises(gym.error.ResetNeeded, match="run_interval"):
         env.run_interval(1, 4)
+
+
+def paper_trigger(env: gym.Env, factor: float = 1.0):
+    """The env's paper trigger with its threshold keywords scaled by ``factor``."""
+    env_id = env.spec.id
+    scaled = {name: factor * value for name, value in PAPER_THRESHOLDS[env_id]().items()}
+    unwrapped = env.unwrapped
+    return PAPER_TRIGGERS[env_id](
+        env.observation_space, env.action_space, unwrapped.observation_names, **scaled
+    )
+
+
+RULE_HORIZONS_S = {
+    "etsc/AsteroidOrbitKeeping-v0": 1200.0,
+    "etsc/ClusterContainmentCentral-v0": 20.0,
+}
+"""Longer horizons where the paper's rule sends only every minute or so."""
+
+
+def rule_stepped(env: gym.Env, trigger, instants: int, gamma: float) -> tuple:
+    """What ``run_rule_interval`` should return, from ``step`` one instant at a time: the
+    trigger decides every instant, and the interval ends before a later instant at which it
+    sends."""
+    total, observation = 0.0, env.unwrapped.arrays.observation[0].copy()
+    info: dict = {}
+    for instant in range(instants):
+        action, _ = trigger.predict(observation)
+        if instant > 0 and np.any(action):
+            return observation, total, False, False, info, instant
+        observation, reward, terminated, truncated, info = env.step(action)
+        total += gamma**instant * reward
+        if terminated or truncated:
+            break
+    return observation, total, terminated, truncated, info, instant + 1
+
+
+@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+def test_a_rule_interval_equals_the_rules_steps(env_id):
+    """Intervals of the paper's rule (several thresholds) end where the stepped rule sends
+    again, and the last one runs on to the horizon, bit for bit."""
+    horizon_s = RULE_HORIZONS_S.get(env_id, HORIZONS_S[env_id])
+    compiled, stepwise = pair(env_id, horizon_s=horizon_s, randomize=True)
+    triggers = [paper_trigger(compiled, factor) for factor in (0.5, 1.0, 1.5)]
+    n_steps = compiled.unwrapped.n_steps
+    lengths, index = [], 0
+    while compiled.unwrapped.step_index < n_steps:
+        trigger = triggers[index % len(triggers)]
+        got = compiled.unwrapped.run_rule_interval(trigger, n_steps, 0.99)
+        assert_same_loop(compiled, stepwise, got, rule_stepped(stepwise, trigger, n_steps, 0.99))
+        lengths.append(got[5])
+        index += 1
+    assert got[3] and "episode_metrics" in got[4]
+    assert len(lengths) > 2, "the rule sent again within the horizon"
+
+
+@pytest.mark.parametrize("env_id", sorted(ENV_IDS))
+def test_a_rule_interval_stops_at_a_failure_as_its_steps_do(env_id):
+    kwargs, failure_step = FAILING[env_id]
+    compiled, stepwise = pair(env_id, seed=0, **kwargs)
+    if env_id == "etsc/ClusterContainmentCentral-v0":  # eq. (15) needs c < 1: raise rho
+        trigger = PAPER_TRIGGERS[env_id](
+            compiled.observation_space,
+            compiled.action_space,
+            compiled.unwrapped.observation_names,
+            rho=1e12,
+        )
+    else:
+        trigger = paper_trigger(compiled, 1e6)  # sends at most at the reset, then holds
+    got = compiled.unwrapped.run_rule_interval(trigger, 2 * failure_step, 0.99)
+    assert got[2] and abs(got[5] - failure_step) <= 1
+    expected = rule_stepped(stepwise, trigger, 2 * failure_step, 0.99)
+    assert_same_loop(compiled, stepwise, got, expected)
+
+
+def test_a_rule_interval_refuses_a_trigger_of_another_env():
+    env = gym.make("etsc/InnerFormation-v0", horizon_s=0.1)
+    other = gym.make("etsc/AttitudeTracking-v0", horizon_s=0.1)
+    env.reset(seed=SEED)
+    with pytest.raises(ValueError, match="trigger must be a paper rule"):
+        env.unwrapped.run_rule_interval(paper_trigger(other), 4)
+    with pytest.raises(ValueError, match="trigger must be a paper rule"):
+        env.unwrapped.run_rule_interval(
+            PeriodicPolicy(other.observation_space, other.action_space, every=2), 4
+        )

@@ -25,10 +25,15 @@ page's step semantics are written once:
 :func:`make_loop_interval` compiles, around the same step, an interval of several instants
 (a first action, then holds) in one call, for decisions that hold the channel for many
 instants (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`).
+:func:`loop_rule_interval` does the same for instants decided by a paper's triggering rule
+(a compiled kernel of :class:`~etsc_envs.triggers.base.RuleTrigger`): the rule reads each
+instant's observation inside the loop, for the self-triggered "follow the paper" decisions and
+for evaluating a paper trigger over whole episodes without a Python call per instant.
 """
 
 from __future__ import annotations
 
+import functools
 from collections import namedtuple
 from collections.abc import Callable
 from typing import Any
@@ -303,6 +308,94 @@ def make_loop_interval(loop_step: Callable[..., None]) -> Callable[..., None]:
             actions = hold
 
     return loop_interval
+
+
+@functools.cache
+def loop_rule_interval(
+    loop_step: Callable[..., None], rule: Callable[..., None]
+) -> Callable[..., None]:
+    """Compile (once per step and rule) an interval whose instants a triggering rule decides.
+
+    The compiled function has the signature ``interval(active, arrays, constants, h, n_steps,
+    cost_scale, transmission_penalty, failure_cost, indices, parameters, instants,
+    stop_on_rule, gamma, actions, discounted, channel_returns, steps_run, step_costs,
+    step_sent)``; the arguments from ``arrays`` to ``failure_cost`` are ``loop_step``'s, and
+    ``indices``, ``parameters`` those of ``rule(observation, indices, parameters, out)``. At
+    each instant every running row's transmit bits are ``rule`` applied to its current
+    observation (written to the scratch ``actions``, ``(n, C)`` int64), then ``loop_step``
+    advances the running rows. A row runs ``instants`` instants, or until it fails or reaches
+    the horizon ``n_steps``, or — with ``stop_on_rule`` — until just before a later instant
+    (not the first) at which the rule sends on any channel: that instant is left for the next
+    call. Per row it adds ``gamma**k * reward_k`` to ``discounted`` and each channel's reward
+    to ``channel_returns`` (both summed in order, as a Python loop over the steps would, and
+    not zeroed first), and writes ``steps_run`` and each instant's accuracy cost and transmit
+    bits in ``step_costs[:, k]`` and ``step_sent[:, k]`` (``(n, >= instants)`` and
+    ``(n, >= instants, C)`` arrays). The loop arrays end exactly as after ``steps_run`` calls
+    of ``loop_step`` with the rule's decisions.
+    """
+
+    @closure_jit
+    def rule_interval(
+        active,
+        arrays,
+        constants,
+        h,
+        n_steps,
+        cost_scale,
+        transmission_penalty,
+        failure_cost,
+        indices,
+        parameters,
+        instants,
+        stop_on_rule,
+        gamma,
+        actions,
+        discounted,
+        channel_returns,
+        steps_run,
+        step_costs,
+        step_sent,
+    ):
+        running = active.copy()
+        steps_run[:] = 0
+        observations = arrays.observation
+        n_channels = actions.shape[1]
+        for instant in range(instants):
+            any_running = False
+            for i in range(running.shape[0]):
+                if not running[i]:
+                    continue
+                rule(observations[i], indices, parameters, actions[i])
+                if stop_on_rule and instant > 0 and actions[i].sum() > 0:
+                    running[i] = False
+                else:
+                    any_running = True
+            if not any_running:
+                break
+            loop_step(
+                actions,
+                running,
+                arrays,
+                constants,
+                h,
+                n_steps,
+                cost_scale,
+                transmission_penalty,
+                failure_cost,
+            )
+            discount = gamma ** float(instant)
+            for i in range(running.shape[0]):
+                if not running[i]:
+                    continue
+                discounted[i] += discount * arrays.reward[i]
+                for channel in range(n_channels):
+                    channel_returns[i, channel] += arrays.channel_rewards[i, channel]
+                step_costs[i, instant] = arrays.cost[i]
+                step_sent[i, instant] = arrays.sent[i]
+                steps_run[i] = instant + 1
+                running[i] = arrays.failure_code[i] == 0 and arrays.step_index[i] < n_steps
+
+    return rule_interval
 
 
 def compiled_entry(dispatcher: Any, *args: Any) -> Callable[..., Any]:

@@ -39,6 +39,7 @@ from etsc_envs.core.compiled_loop import (
     ProblemKernels,
     allocate_loop_arrays,
     compiled_entry,
+    loop_rule_interval,
     make_loop_interval,
     make_loop_step,
 )
@@ -160,6 +161,7 @@ class EventTriggeredEnv(gym.Env):
         self.state = arrays.state[0]
         self._loop_step_entry = None
         self._loop_interval_entry = None
+        self._rule_interval_entries: dict[Any, Callable[..., Any]] = {}
 
     def __getstate__(self) -> dict[str, Any]:
         """Everything but the compiled entry points (machine code, not picklable; rebuilt from
@@ -167,6 +169,7 @@ class EventTriggeredEnv(gym.Env):
         state = self.__dict__.copy()
         state["_loop_step_entry"] = None
         state["_loop_interval_entry"] = None
+        state["_rule_interval_entries"] = {}
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -296,20 +299,71 @@ class EventTriggeredEnv(gym.Env):
         instants = require_int_at_least("instants", instants, 1)
         gamma = require_discount("gamma", gamma)
         self._set_transmit_bits("first_action", first_action)
-        outputs = self._interval_outputs
-        if outputs.step_costs.shape[1] < instants:
-            outputs = self._interval_outputs = _interval_outputs(instants, self.n_channels)
+        outputs = self._outputs_for(instants)
         arguments = (*self._loop_arguments(), instants, gamma, *outputs)
         if self._loop_interval_entry is None:
             self._loop_interval_entry = compiled_entry(self.loop_interval, *arguments)
         start = self.step_index
         self._loop_interval_entry(*arguments)
+        return self._interval_outcome(start, outputs)
+
+    def run_rule_interval(
+        self, trigger: Any, instants: int, gamma: float = 1.0
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
+        """Run up to ``instants`` sampling instants decided by a paper's triggering rule in one
+        compiled call, ending just before a later instant (not the first) at which the rule
+        sends, at a failure or at the horizon: a self-triggered "follow the paper" interval.
+
+        ``trigger`` is a :class:`~etsc_envs.triggers.base.RuleTrigger` built for this env's
+        observations. The episode ends exactly as after giving :meth:`step` the trigger's
+        decisions one instant at a time; the return is :meth:`run_interval`'s.
+        """
+        self._require_running("run_rule_interval")
+        instants = require_int_at_least("instants", instants, 1)
+        gamma = require_discount("gamma", gamma)
+        if getattr(trigger, "n_channels", None) != self.n_channels:
+            raise ValueError(
+                f"trigger must be a paper rule (RuleTrigger) with {self.n_channels} transmit "
+                f"bit(s), got {trigger!r}"
+            )
+        outputs = self._outputs_for(instants)
+        outputs.discounted[:] = 0.0
+        arguments = (
+            *self._loop_arguments()[1:],
+            trigger.rule_indices,
+            trigger.rule_parameters,
+            instants,
+            True,
+            gamma,
+            self._actions,
+            outputs.discounted,
+            np.zeros((1, self.n_channels)),
+            outputs.steps_run,
+            outputs.step_costs,
+            outputs.step_sent,
+        )
+        rule = type(trigger).rule
+        entry = self._rule_interval_entries.get(rule)
+        if entry is None:
+            function = loop_rule_interval(self.loop_step, rule)
+            entry = self._rule_interval_entries[rule] = compiled_entry(function, *arguments)
+        start = self.step_index
+        entry(*arguments)
+        return self._interval_outcome(start, outputs)
+
+    def _outputs_for(self, instants: int) -> IntervalOutputs:
+        """The interval's output arrays, grown to hold ``instants`` instants."""
+        if self._interval_outputs.step_costs.shape[1] < instants:
+            self._interval_outputs = _interval_outputs(instants, self.n_channels)
+        return self._interval_outputs
+
+    def _interval_outcome(
+        self, start: int, outputs: IntervalOutputs
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
+        """Note an interval that began at instant ``start`` for :meth:`render`, and return
+        what :meth:`run_interval` returns."""
         steps_run = int(outputs.steps_run[0])
-        if self._trace is not None:
-            for instant in range(steps_run):
-                time_s = (start + instant + 1) * self.sampling_period_s
-                sent = outputs.step_sent[0, instant]
-                self._trace.record(time_s, float(outputs.step_costs[0, instant]), sent)
+        self.trace_interval(start, outputs.step_costs[0, :steps_run], outputs.step_sent[0])
         observation, terminated, truncated, info = self._outcome()
         discounted = float(outputs.discounted[0])
         return observation, discounted, terminated, truncated, info, steps_run
@@ -383,6 +437,14 @@ class EventTriggeredEnv(gym.Env):
         """Note the step just taken for :meth:`render` (nothing unless rendering)."""
         if self._trace is not None:
             self._trace.record(self.time_s, float(self.arrays.cost[0]), self.arrays.sent[0])
+
+    def trace_interval(self, start: int, costs: np.ndarray, sent: np.ndarray) -> None:
+        """Note the ``len(costs)`` steps just run after instant ``start`` in one compiled call
+        (each step's accuracy cost and transmit bits) for :meth:`render`."""
+        if self._trace is not None:
+            for instant, cost in enumerate(costs):
+                time_s = (start + instant + 1) * self.sampling_period_s
+                self._trace.record(time_s, float(cost), sent[instant])
 
     def render(self) -> np.ndarray | None:
         """With ``render_mode="rgb_array"``, the episode so far as an RGB array: the accuracy

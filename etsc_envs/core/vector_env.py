@@ -28,7 +28,12 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from etsc_envs.core.compiled_loop import allocate_loop_arrays, compiled_entry, loop_rows
+from etsc_envs.core.compiled_loop import (
+    allocate_loop_arrays,
+    compiled_entry,
+    loop_rows,
+    loop_rule_interval,
+)
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.render import RENDER_MODES
 from etsc_envs.core.validation import require_reset_options
@@ -131,12 +136,19 @@ class EventTriggeredVectorEnv(VectorEnv):
         self._pool = ThreadPoolExecutor(len(self._chunks)) if len(self._chunks) > 1 else None
         self._chunk_arrays = [loop_rows(self.arrays, *chunk) for chunk in self._chunks]
         self._loop_step_entry = None
+        self._rule_interval_entries: dict[Any, Any] = {}
 
     def __getstate__(self) -> dict[str, Any]:
         """Everything but the thread pool, the compiled entry point and the row views (pickle
         would copy a view as an array of its own), rebuilt by :meth:`__setstate__`."""
         state = self.__dict__.copy()
-        for name in ("_pool", "_loop_step_entry", "_chunks", "_chunk_arrays"):
+        for name in (
+            "_pool",
+            "_loop_step_entry",
+            "_rule_interval_entries",
+            "_chunks",
+            "_chunk_arrays",
+        ):
             state.pop(name, None)
         return state
 
@@ -220,6 +232,78 @@ class EventTriggeredVectorEnv(VectorEnv):
         infos.update(self._step_infos())
         return arrays.observation.copy(), rewards, terminated, truncated, infos
 
+    def run_rule(
+        self,
+        trigger: Any,
+        instants: int,
+        returns: np.ndarray,
+        channel_returns: np.ndarray,
+    ) -> np.ndarray:
+        """Advance every sub-environment whose episode runs by up to ``instants`` sampling
+        instants, each decided by a paper's triggering rule, in one compiled call per stepping
+        thread (:func:`~etsc_envs.core.compiled_loop.loop_rule_interval`): exactly the
+        :meth:`step` calls with the trigger's decisions, without a Python call per instant.
+
+        ``trigger`` is a :class:`~etsc_envs.triggers.base.RuleTrigger` for the single env's
+        observations. Each row's rewards are added to ``returns`` (``(num_envs,)``) and its
+        per-channel rewards to ``channel_returns`` (``(num_envs, C)``). A sub-environment stops
+        where its episode ends; like :meth:`step`, the next step resets it. Returns the
+        instants each row ran.
+        """
+        first = self.envs[0]
+        if getattr(trigger, "n_channels", None) != first.n_channels:
+            raise ValueError(
+                f"trigger must be a paper rule (RuleTrigger) with {first.n_channels} transmit "
+                f"bit(s), got {trigger!r}"
+            )
+        instants = int(instants)
+        active = ~self._needs_reset
+        steps_run = np.zeros(self.num_envs, dtype=np.int64)
+        step_costs = np.zeros((self.num_envs, instants))
+        step_sent = np.zeros((self.num_envs, instants, first.n_channels), dtype=np.int64)
+        start_index = self.arrays.step_index.copy()
+        rule = type(trigger).rule
+
+        def arguments(chunk: int) -> tuple[Any, ...]:
+            start, stop = self._chunks[chunk]
+            return (
+                active[start:stop],
+                self._chunk_arrays[chunk],
+                first.constants,
+                first.sampling_period_s,
+                first.n_steps,
+                first.cost_scale,
+                first.transmission_penalty,
+                first.failure_cost,
+                trigger.rule_indices,
+                trigger.rule_parameters,
+                instants,
+                False,
+                1.0,
+                self._actions[start:stop],
+                returns[start:stop],
+                channel_returns[start:stop],
+                steps_run[start:stop],
+                step_costs[start:stop],
+                step_sent[start:stop],
+            )
+
+        entry = self._rule_interval_entries.get(rule)
+        if entry is None:
+            function = loop_rule_interval(first.loop_step, rule)
+            entry = self._rule_interval_entries[rule] = compiled_entry(function, *arguments(0))
+        self._run_chunks(lambda chunk: entry(*arguments(chunk)))
+        arrays = self.arrays
+        self._needs_reset |= active & (
+            (arrays.failure_code != 0) | (arrays.step_index >= first.n_steps)
+        )
+        if self.render_mode is not None:
+            for row in np.flatnonzero(active):
+                self.envs[row].trace_interval(
+                    int(start_index[row]), step_costs[row, : steps_run[row]], step_sent[row]
+                )
+        return steps_run
+
     def render(self) -> tuple[np.ndarray, ...] | None:
         """One frame per sub-environment with ``render_mode="rgb_array"``, else ``None``."""
         if self.render_mode is None:
@@ -255,16 +339,17 @@ class EventTriggeredVectorEnv(VectorEnv):
             self._loop_step_entry = compiled_entry(first.loop_step, *arguments(0))
         entry = self._loop_step_entry
 
-        def advance(chunk: int) -> None:
-            entry(*arguments(chunk))
+        self._run_chunks(lambda chunk: entry(*arguments(chunk)))
 
+    def _run_chunks(self, work: Any) -> None:
+        """``work(chunk)`` for every row range, each on its own stepping thread."""
         if self._pool is None:
-            advance(0)
-        else:
-            others = [self._pool.submit(advance, c) for c in range(1, len(self._chunks))]
-            advance(0)
-            for future in others:
-                future.result()
+            work(0)
+            return
+        others = [self._pool.submit(work, c) for c in range(1, len(self._chunks))]
+        work(0)
+        for future in others:
+            future.result()
 
     def _step_infos(self) -> dict[str, np.ndarray]:
         """The per-step info keys of every sub-environment, batched (all present)."""

@@ -2,18 +2,25 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import gymnasium as gym
 import numpy as np
 
-from etsc_envs.triggers.base import TriggerPolicy
+from etsc_envs.core.jit import jit
+from etsc_envs.triggers.base import RuleTrigger
 
 PAPER_ALPHA = 0.05
 """α of eq. (15) in section 4, m²/s."""
 
 
-class AsteroidOrbitKeepingTrigger(TriggerPolicy):
+@jit
+def asteroid_rule(observation, indices, parameters, out):
+    """Eq. (15) on one observation: start a burst when ``barrier_m2ps`` (``indices[0]``) + α
+    (``parameters[0]``) <= 0 and no burst runs (``burst_active``, ``indices[1]``, below 0.5)."""
+    fires = observation[indices[0]] + parameters[0] <= 0.0 and observation[indices[1]] < 0.5
+    out[0] = 1 if fires else 0
+
+
+class AsteroidOrbitKeepingTrigger(RuleTrigger):
     """Eq. (15): start a burst when (r_0 - ‖r‖) r·ṙ / ‖r‖ + α <= 0 and none is running.
 
     The environment's ``barrier_m2ps`` observation is (r_0 - ‖r‖) r·ṙ / ‖r‖; the statistic is
@@ -31,14 +38,16 @@ class AsteroidOrbitKeepingTrigger(TriggerPolicy):
         observation_names: tuple[str, ...],
         alpha: float = PAPER_ALPHA,
     ) -> None:
-        super().__init__(observation_space, action_space)
         alpha = float(alpha)
         if not np.isfinite(alpha) or alpha <= 0.0:
             raise ValueError(f"alpha must be a finite number > 0 (m^2/s), got {alpha!r}")
         self.alpha = alpha
-        self.barrier_index = observation_names.index("barrier_m2ps")
-        self.burst_index = observation_names.index("burst_active")
+        super().__init__(
+            observation_space,
+            action_space,
+            indices=[observation_names.index(name) for name in ("barrier_m2ps", "burst_active")],
+            parameters=[alpha],
+            keywords={"alpha": alpha},
+        )
 
-    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
-        fires = obs[:, self.barrier_index] + self.alpha <= 0.0
-        return fires & (obs[:, self.burst_index] < 0.5), state
+    rule = staticmethod(asteroid_rule)

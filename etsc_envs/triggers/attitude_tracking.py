@@ -2,18 +2,24 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import gymnasium as gym
 import numpy as np
 
-from etsc_envs.triggers.base import TriggerPolicy
+from etsc_envs.core.jit import jit
+from etsc_envs.triggers.base import RuleTrigger
 
 PAPER_PSI = 0.1
 """Ψ of Tables 1-3's first event-triggered rows (the paper also runs 1.5 and 2.5)."""
 
 
-class AttitudeTrackingTrigger(TriggerPolicy):
+@jit
+def attitude_tracking_rule(observation, indices, parameters, out):
+    """Eq. (27) on one observation: transmit when ``trigger_statistic`` (``indices[0]``) > Ψ
+    (``parameters[0]``)."""
+    out[0] = 1 if observation[indices[0]] > parameters[0] else 0
+
+
+class AttitudeTrackingTrigger(RuleTrigger):
     """Γ(t) of eq. (27): transmit when Σ_i Σ_j |α_ji(e_1i, σ_i)| > Ψ ε_min.
 
     The environment's ``trigger_statistic`` observation is that sum divided by ε_min, computed by
@@ -31,12 +37,16 @@ class AttitudeTrackingTrigger(TriggerPolicy):
         observation_names: tuple[str, ...],
         psi: float = PAPER_PSI,
     ) -> None:
-        super().__init__(observation_space, action_space)
         psi = float(psi)
         if not np.isfinite(psi) or psi <= 0.0:
             raise ValueError(f"psi must be a finite number > 0, got {psi!r}")
         self.psi = psi
-        self.statistic_index = observation_names.index("trigger_statistic")
+        super().__init__(
+            observation_space,
+            action_space,
+            indices=[observation_names.index("trigger_statistic")],
+            parameters=[psi],
+            keywords={"psi": psi},
+        )
 
-    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
-        return obs[:, self.statistic_index] > self.psi, state
+    rule = staticmethod(attitude_tracking_rule)

@@ -3,16 +3,21 @@
 Every policy has ``predict(obs, state=None, episode_start=None, deterministic=True) ->
 (action, state)`` and accepts one observation or a batch (leading axis), so a single evaluator
 runs paper triggers, periodic schedules and trained models alike. :class:`TriggerPolicy` is the
-base of the papers' rules (:mod:`etsc_envs.triggers`); :class:`AlwaysPolicy` and
-:class:`PeriodicPolicy` are the time-triggered references.
+base of every policy here, :class:`RuleTrigger` that of the papers' rules
+(:mod:`etsc_envs.triggers`); :class:`AlwaysPolicy` and :class:`PeriodicPolicy` are the
+time-triggered references.
 """
 
 from __future__ import annotations
 
-from typing import Any
+import functools
+from collections.abc import Callable
+from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
+
+from etsc_envs.core.jit import closure_jit
 
 
 def transmit_bits(action_space: gym.Space) -> int | None:
@@ -64,6 +69,79 @@ class TriggerPolicy:
     def reset_state(self, state: Any, episode_start: np.ndarray, batch: int) -> Any:
         """State after episodes restart where ``episode_start`` is set (stateless by default)."""
         return state
+
+
+@functools.cache
+def batched_rule(rule: Callable[..., None]) -> Callable[..., None]:
+    """The compiled ``apply(observations, indices, parameters, out)`` that runs the per-instant
+    kernel ``rule`` (see :class:`RuleTrigger`) on every row of ``observations`` (float32,
+    ``(batch, F)``) into ``out`` (int64, ``(batch, C)``)."""
+
+    @closure_jit
+    def apply(observations, indices, parameters, out):
+        for row in range(observations.shape[0]):
+            rule(observations[row], indices, parameters, out[row])
+
+    return apply
+
+
+class RuleTrigger(TriggerPolicy):
+    """Base of the papers' triggering rules: a stateless condition on one observation, written
+    once as a compiled kernel.
+
+    The class's :attr:`rule` has the signature ``rule(observation, indices, parameters, out)``:
+    ``observation`` is one float32 observation row, ``indices`` (int64) and ``parameters``
+    (float64) are the trigger's :attr:`rule_indices` and :attr:`rule_parameters`, and the rule
+    writes 1 (transmit) or 0 (hold) for each channel into ``out`` (int64, one entry per
+    transmit bit). :meth:`transmit` applies it to a batch of observations, and the compiled
+    loop runs the same kernel inside its step loop
+    (:func:`~etsc_envs.core.compiled_loop.make_loop_rule_interval`), so that Python and
+    compiled decisions are the same by construction.
+
+    Args:
+        observation_space, action_space: the environment's spaces.
+        indices: the observation components the rule reads.
+        parameters: its design parameters, in the order the kernel reads them.
+        keywords: the constructor keywords that give this trigger, so that
+            :meth:`for_observations` can rebuild it for another observation layout.
+    """
+
+    rule: ClassVar[Callable[..., None]]
+
+    def __init__(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        indices: Any,
+        parameters: Any,
+        keywords: dict[str, Any],
+    ) -> None:
+        super().__init__(observation_space, action_space)
+        self.rule_indices = np.ascontiguousarray(indices, dtype=np.int64).reshape(-1)
+        self.rule_parameters = np.ascontiguousarray(parameters, dtype=np.float64).reshape(-1)
+        self.keywords = dict(keywords)
+
+    @property
+    def n_channels(self) -> int:
+        """Transmit bits the rule writes per observation."""
+        return 1 if self.n_bits is None else self.n_bits
+
+    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
+        observations = np.ascontiguousarray(obs, dtype=np.float32)
+        out = np.zeros((len(observations), self.n_channels), dtype=np.int64)
+        batched_rule(type(self).rule)(observations, self.rule_indices, self.rule_parameters, out)
+        fires = out.astype(bool)
+        return (fires[:, 0] if self.n_bits is None else fires), state
+
+    def for_observations(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        observation_names: tuple[str, ...],
+    ) -> RuleTrigger:
+        """The same rule, with the same keywords, for an env of other spaces and names (the
+        loop of a PettingZoo id, whose agents each see a slice of its observation)."""
+        return type(self)(observation_space, action_space, observation_names, **self.keywords)
 
 
 class AlwaysPolicy(TriggerPolicy):

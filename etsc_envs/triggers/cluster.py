@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import gymnasium as gym
 import numpy as np
 
-from etsc_envs.triggers.base import TriggerPolicy
+from etsc_envs.core.jit import jit
+from etsc_envs.triggers.base import RuleTrigger, transmit_bits
 
 PAPER_C, PAPER_RHO, PAPER_NU = 0.6, 2.0, 0.5
 """c_i, ρ_i, ν_i of section 5.1 (the same for every follower)."""
 
 
+@jit
 def trigger_threshold(
     state_threshold: np.ndarray,
     sqrt_lambda_min_k: np.ndarray,
@@ -23,12 +23,33 @@ def trigger_threshold(
 ) -> np.ndarray:
     """Right side of eq. (15): (c/2) λ_min(K) ‖s‖ + ρ √λ_min(K) exp(-ν t).
 
-    ``state_threshold`` is the environment's ½ λ_min(K) ‖s‖.
+    ``state_threshold`` is the environment's ½ λ_min(K) ‖s‖ (numbers or arrays alike).
     """
     return c * state_threshold + rho * sqrt_lambda_min_k * np.exp(-nu * time_s)
 
 
-class ClusterContainmentTrigger(TriggerPolicy):
+@jit
+def cluster_rule(observation, indices, parameters, out):
+    """Eq. (15) on one observation, for each of the ``n = len(out)`` followers i: fire when
+    ``event_error_i >= trigger_threshold(state_threshold_i, sqrt_lambda_min_K_i, time_s_i)``.
+
+    ``indices`` holds the n indices of each of those four names in turn; ``parameters`` holds
+    c, ρ, ν.
+    """
+    n = out.shape[0]
+    for i in range(n):
+        threshold = trigger_threshold(
+            float(observation[indices[n + i]]),
+            float(observation[indices[2 * n + i]]),
+            float(observation[indices[3 * n + i]]),
+            parameters[0],
+            parameters[1],
+            parameters[2],
+        )
+        out[i] = 1 if float(observation[indices[i]]) >= threshold else 0
+
+
+class ClusterContainmentTrigger(RuleTrigger):
     """Eq. (15): follower i's event fires when ‖e_J‖ + λ_max(K)‖e_s‖ ≥ (c/2) λ_min(K)‖s‖ + μ(t),
     with μ(t) = ρ √λ_min(K) exp(-ν t).
 
@@ -52,7 +73,6 @@ class ClusterContainmentTrigger(TriggerPolicy):
         rho: float = PAPER_RHO,
         nu: float = PAPER_NU,
     ) -> None:
-        super().__init__(observation_space, action_space)
         self.c, self.rho, self.nu = float(c), float(rho), float(nu)
         if not 0.0 < self.c < 1.0:
             raise ValueError(f"c must satisfy 0 < c < 1 (eq. 15), got {c!r}")
@@ -61,20 +81,19 @@ class ClusterContainmentTrigger(TriggerPolicy):
         if not 0.0 < self.nu < 1.0:
             raise ValueError(f"nu must satisfy 0 < nu < 1 (eq. 15), got {nu!r}")
         names = ("event_error", "state_threshold", "sqrt_lambda_min_K", "time_s")
-        if self.n_bits is None and "event_error" in observation_names:
+        n_bits = transmit_bits(action_space)
+        if n_bits is None and "event_error" in observation_names:
             suffixes = [""]
         else:
-            suffixes = [f"_{i}" for i in range(self.n_bits or 1)]
-        self.indices = np.array(
-            [[observation_names.index(name + suffix) for suffix in suffixes] for name in names]
+            suffixes = [f"_{i}" for i in range(n_bits or 1)]
+        super().__init__(
+            observation_space,
+            action_space,
+            indices=[
+                observation_names.index(name + suffix) for name in names for suffix in suffixes
+            ],
+            parameters=[self.c, self.rho, self.nu],
+            keywords={"c": self.c, "rho": self.rho, "nu": self.nu},
         )
 
-    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
-        event_error, state_threshold, sqrt_lambda, time_s = (
-            obs[:, rows].astype(np.float64) for rows in self.indices
-        )
-        threshold = trigger_threshold(
-            state_threshold, sqrt_lambda, time_s, self.c, self.rho, self.nu
-        )
-        fire = event_error >= threshold
-        return (fire[:, 0] if self.n_bits is None else fire), state
+    rule = staticmethod(cluster_rule)

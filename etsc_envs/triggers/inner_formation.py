@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import gymnasium as gym
 import numpy as np
 
+from etsc_envs.core.jit import jit
 from etsc_envs.inner_formation.design import equal_share_thresholds
 from etsc_envs.inner_formation.params import InnerFormationParams
-from etsc_envs.triggers.base import TriggerPolicy
+from etsc_envs.triggers.base import RuleTrigger
 
 AXES = ("x", "y", "z")
 
@@ -22,7 +21,15 @@ def default_thresholds() -> np.ndarray:
     return equal_share_thresholds(InnerFormationParams())
 
 
-class InnerFormationTrigger(TriggerPolicy):
+@jit
+def inner_formation_rule(observation, indices, parameters, out):
+    """Eqs. (4)-(6) on one observation: axis i transmits when |r_i(t) - r_i(t_k)|
+    (``sampling_error_m_*``, ``indices[i]``) > Π_i (``parameters[i]``)."""
+    for axis in range(3):
+        out[axis] = 1 if abs(float(observation[indices[axis]])) > parameters[axis] else 0
+
+
+class InnerFormationTrigger(RuleTrigger):
     """Axis i transmits when |r_i(t) - r_i(t_k)| > Π_i (the complement of eqs. 4-6).
 
     Args:
@@ -41,7 +48,6 @@ class InnerFormationTrigger(TriggerPolicy):
         pi2: float | None = None,
         pi3: float | None = None,
     ) -> None:
-        super().__init__(observation_space, action_space)
         thresholds = default_thresholds() if pi is None else np.full(3, float(pi))
         for axis, value in enumerate((pi1, pi2, pi3)):
             if value is not None:
@@ -49,10 +55,15 @@ class InnerFormationTrigger(TriggerPolicy):
         if not np.all(np.isfinite(thresholds)) or np.any(thresholds <= 0.0):
             raise ValueError(f"pi, pi1, pi2, pi3 must be finite numbers > 0 (m), got {thresholds}")
         self.thresholds = thresholds
-        self.error_indices = [observation_names.index(f"sampling_error_m_{a}") for a in AXES]
+        super().__init__(
+            observation_space,
+            action_space,
+            indices=[observation_names.index(f"sampling_error_m_{a}") for a in AXES],
+            parameters=thresholds,
+            keywords={"pi1": thresholds[0], "pi2": thresholds[1], "pi3": thresholds[2]},
+        )
 
-    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
-        return np.abs(obs[:, self.error_indices]) > self.thresholds, state
+    rule = staticmethod(inner_formation_rule)
 
 
 def predicted_sampling_error(velocity_estimate: np.ndarray, hold_s: np.ndarray) -> np.ndarray:

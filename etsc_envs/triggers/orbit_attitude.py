@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import gymnasium as gym
 import numpy as np
 
-from etsc_envs.triggers.base import TriggerPolicy
+from etsc_envs.core.jit import jit
+from etsc_envs.triggers.base import RuleTrigger
 
 PAPER_A = (0.6, 0.8)
 """a1, a2 of section IV (Theorem 2 needs K21 = 3.2 > a1 and K22 = 3.6 > a2)."""
@@ -22,7 +21,28 @@ def _positive(name: str, value: float) -> float:
     return value
 
 
-class OrbitAttitudeTrigger(TriggerPolicy):
+@jit
+def orbit_attitude_rule(observation, indices, parameters, out):
+    """Eq. (21) on one observation: transmit when ``‖ē_cj‖ ≥ a_j ‖S̄_j‖ + γ_j`` for j = 1 or 2.
+
+    ``indices`` holds ``ec1_*, ec2_*`` (entries 0-5) then ``s1_*, s2_*`` (6-11);
+    ``parameters`` holds a1, a2, γ1, γ2.
+    """
+    fires = 0
+    for j in range(2):
+        error = 0.0
+        surface = 0.0
+        for axis in range(3):
+            component = float(observation[indices[3 * j + axis]])
+            error += component * component
+            component = float(observation[indices[6 + 3 * j + axis]])
+            surface += component * component
+        if np.sqrt(error) >= parameters[j] * np.sqrt(surface) + parameters[2 + j]:
+            fires = 1
+    out[0] = fires
+
+
+class OrbitAttitudeTrigger(RuleTrigger):
     """Eq. (21): transmit when ``‖ē_c1‖ ≥ a1 ‖S̄1‖ + γ1`` or ``‖ē_c2‖ ≥ a2 ‖S̄2‖ + γ2``.
 
     ``e_c = Γ_c - Γ_cout`` is the held command minus the controller's current one (observation
@@ -46,21 +66,15 @@ class OrbitAttitudeTrigger(TriggerPolicy):
         gamma1: float = PAPER_GAMMA[0],
         gamma2: float = PAPER_GAMMA[1],
     ) -> None:
-        super().__init__(observation_space, action_space)
         self.a = np.array([_positive("a1", a1), _positive("a2", a2)])
         self.gamma = np.array([_positive("gamma1", gamma1), _positive("gamma2", gamma2)])
+        names = [f"{prefix}_{axis}" for prefix in ("ec1", "ec2", "s1", "s2") for axis in "xyz"]
+        super().__init__(
+            observation_space,
+            action_space,
+            indices=[observation_names.index(name) for name in names],
+            parameters=np.concatenate([self.a, self.gamma]),
+            keywords={"a1": a1, "a2": a2, "gamma1": gamma1, "gamma2": gamma2},
+        )
 
-        def index(prefix: str) -> list[int]:
-            return [observation_names.index(f"{prefix}_{axis}") for axis in "xyz"]
-
-        # (2, 3) index blocks: rows j = 1, 2 of eq. (21)
-        self.ec = np.array([index("ec1"), index("ec2")])
-        self.s = np.array([index("s1"), index("s2")])
-
-    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
-        obs = np.asarray(obs, dtype=np.float64)
-        error = obs[:, self.ec]  # (batch, 2, 3)
-        surface = obs[:, self.s]
-        error_norm = np.sqrt(np.einsum("bij,bij->bi", error, error))
-        surface_norm = np.sqrt(np.einsum("bij,bij->bi", surface, surface))
-        return (error_norm >= self.a * surface_norm + self.gamma).any(axis=1), state
+    rule = staticmethod(orbit_attitude_rule)
