@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from etsc_envs.triggers.asteroid import PAPER_ALPHA, AsteroidOrbitKeepingTrigger
+from etsc_envs.triggers.asteroid import PAPER_ALPHA, AsteroidOrbitKeepingTrigger, AsteroidShield
 from etsc_envs.triggers.attitude_tracking import PAPER_PSI, AttitudeTrackingTrigger
 from etsc_envs.triggers.base import AlwaysPolicy, PeriodicPolicy, TriggerPolicy
 from etsc_envs.triggers.cluster import PAPER_C, ClusterContainmentTrigger
@@ -54,9 +54,14 @@ PAPER_THRESHOLDS: dict[str, Callable[[], dict[str, float]]] = {
     "etsc/AsteroidOrbitKeeping-v0": lambda: {"alpha": PAPER_ALPHA},
 }
 """Environment id → the keywords of its paper trigger that set how much error it tolerates
-before transmitting, at the paper's values (a larger value transmits less)."""
+before transmitting, at the paper's values (a larger value waits longer; paper 003 nonetheless
+fires more bursts with a larger α: a later burst meets a larger drift, and its saturated
+correction overshoots, docs/results.md)."""
 
-PAPER_SHIELDS = {"etsc/InnerFormation-v0": InnerFormationShield}
+PAPER_SHIELDS = {
+    "etsc/InnerFormation-v0": InnerFormationShield,
+    "etsc/AsteroidOrbitKeeping-v0": AsteroidShield,
+}
 """Environment id → the class of its shield (:class:`InnerFormationShield`'s interface): the
 ids whose papers give a condition under which a hold is unsafe."""
 
@@ -66,6 +71,7 @@ __all__ = [
     "PAPER_TRIGGERS",
     "AlwaysPolicy",
     "AsteroidOrbitKeepingTrigger",
+    "AsteroidShield",
     "AttitudeTrackingTrigger",
     "ClusterContainmentTrigger",
     "InnerFormationTrigger",

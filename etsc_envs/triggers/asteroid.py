@@ -51,3 +51,63 @@ class AsteroidOrbitKeepingTrigger(RuleTrigger):
         )
 
     rule = staticmethod(asteroid_rule)
+
+
+PAPER_SHIELD_MULTIPLE = 1.0
+"""The fraction of the shell's half-width the shield of :class:`AsteroidShield` lets a hold's
+predicted radius error reach (1: the shell [r_min, r_max] itself)."""
+
+
+class AsteroidShield:
+    """Which holds keep the predicted orbital radius inside the shell of section 3.1.
+
+    Section 3.1 calls the motion unsafe when ‖r‖ moves away from r_0 fast enough for the
+    highest (or lowest) radius to pass the barrier r_max (r_min) before thrust acts (Case 1.3,
+    Case 2.2). A hold of h after a decision instant lets no burst start for h; it is called
+    unsafe when the first-order prediction ‖r‖ + (d‖r‖/dt) h leaves r_0 ± m (r_max - r_0)
+    (observations ``radius_m`` and ``radial_velocity_mps``). The burst a hold starts at its
+    decision instant is ignored, so the prediction errs towards forbidding. A hold of one
+    sampling period (a burst as soon as none runs) and the paper's rule (eq. 15 watches the
+    same drift at every instant) are always allowed.
+
+    Args:
+        observation_names: the environment's ``observation_names``.
+        sampling_period_s: the environment's sampling period (s).
+        multiple: m > 0.
+        reference_radius_m, shell_half_width_m: r_0 and r_max - r_0 (the paper's 200 m and
+            5 m by default).
+    """
+
+    def __init__(
+        self,
+        observation_names: tuple[str, ...],
+        sampling_period_s: float,
+        multiple: float = PAPER_SHIELD_MULTIPLE,
+        reference_radius_m: float = 200.0,
+        shell_half_width_m: float = 5.0,
+    ) -> None:
+        multiple = float(multiple)
+        if not np.isfinite(multiple) or multiple <= 0.0:
+            raise ValueError(f"multiple must be a finite number > 0, got {multiple!r}")
+        if not np.isfinite(sampling_period_s) or sampling_period_s <= 0.0:
+            raise ValueError(f"sampling_period_s must be > 0, got {sampling_period_s!r}")
+        self.multiple = multiple
+        self.sampling_period_s = float(sampling_period_s)
+        self.reference_radius_m = float(reference_radius_m)
+        self.allowed_error_m = multiple * float(shell_half_width_m)
+        self.radius_index = observation_names.index("radius_m")
+        self.rate_index = observation_names.index("radial_velocity_mps")
+
+    def allowed_holds(self, obs: np.ndarray, hold_steps: np.ndarray) -> np.ndarray:
+        """Whether each hold of ``hold_steps`` sampling periods is safe at the decision instant
+        of each observation: booleans of shape ``(batch, n)``."""
+        hold_steps = np.asarray(hold_steps)
+        hold_s = hold_steps * self.sampling_period_s
+        radius = np.asarray(obs[:, self.radius_index], dtype=np.float64)[:, None]
+        rate = np.asarray(obs[:, self.rate_index], dtype=np.float64)[:, None]
+        predicted_error = np.abs(radius + rate * hold_s[None, :] - self.reference_radius_m)
+        return (predicted_error <= self.allowed_error_m) | (hold_steps == 1)[None, :]
+
+    def allowed_factors(self, factors: np.ndarray) -> np.ndarray:
+        """The paper's rule is allowed at every threshold factor."""
+        return np.ones(np.shape(factors), dtype=bool)
