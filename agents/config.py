@@ -46,10 +46,15 @@ A config is a YAML mapping with these keys (the optional ones show their default
   on the training envs and clone it into the policy (and its returns into the value
   function; :mod:`agents.imitation`); 0 starts from a random policy;
 * ``imitation_epochs: 10`` — passes over those steps when cloning;
+* ``imitation_decision: null`` — with ``decisions``, the decision to clone for
+  ``imitation_steps`` decisions instead of the per-instant paper trigger, by its label
+  (``"paper x0.25"``, ``"hold 64"``: :meth:`baselines.self_triggered.DecisionSet.label`;
+  :func:`agents.imitation.imitate_decision`); needed with ``decisions`` and
+  ``imitation_steps``, refused without ``decisions``;
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
   ``shield_multiple``; its ``gamma`` is ``hyperparameters.gamma``), on a ``DummyVecEnv`` of
-  wrapped envs (Gymnasium ids only, without ``imitation_steps``). PPO, A2C and MaskablePPO
+  wrapped envs (Gymnasium ids only; cloning with ``imitation_decision``). PPO, A2C and MaskablePPO
   then discount by elapsed instants (:mod:`agents.elapsed_discount`); the models are saved with
   their decision set beside them, so that ``sb3:`` deploys them as transmit/hold policies;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
@@ -112,6 +117,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "init_from": None,
     "imitation_steps": 0,
     "imitation_epochs": 10,
+    "imitation_decision": None,
     "decisions": None,
 }
 
@@ -144,6 +150,7 @@ class TrainConfig:
     init_from: str | None
     imitation_steps: int
     imitation_epochs: int
+    imitation_decision: str | None
     decisions: dict[str, Any] | None
 
     @property
@@ -211,6 +218,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         init_from=_check_init_from(values["init_from"], env_id, env_kwargs, decisions),
         imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
+        imitation_decision=values["imitation_decision"],
         decisions=decisions,
     )
 
@@ -256,24 +264,37 @@ def _check_decisions(
 ) -> dict[str, Any] | None:
     """``values["decisions"]`` if it is null or keywords that build a
     :class:`~agents.decisions.SelfTriggeredWrapper` for ``env_id``."""
+    label = values["imitation_decision"]
     if values["decisions"] is None:
         if algorithm == "MaskablePPO":
             raise ValueError("config key 'algorithm': MaskablePPO needs the key 'decisions'")
+        if label is not None:
+            raise ValueError("config key 'imitation_decision' needs the key 'decisions'")
         return None
     decisions = _check_mapping("decisions", values["decisions"])
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS or values["imitation_steps"]:
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        raise ValueError(f"config key 'decisions' needs a Gymnasium id, got {env_id}")
+    if bool(values["imitation_steps"]) != (label is not None):
         raise ValueError(
-            "config key 'decisions' needs a Gymnasium id and no 'imitation_steps', got "
-            f"{env_id} with imitation_steps={values['imitation_steps']!r}"
+            "config keys 'imitation_steps' and 'imitation_decision' go together with "
+            "'decisions' (the decision to clone, and for how many decisions), got "
+            f"imitation_steps={values['imitation_steps']!r}, imitation_decision={label!r}"
         )
     allowed = ("max_exponent", "factors", "shield_multiple")
     unknown = sorted(set(decisions) - set(allowed))
     if unknown:
         raise ValueError(f"config key 'decisions': {unknown} are not among {list(allowed)}")
     try:
-        SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), **decisions).close()
+        wrapper = SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), **decisions)
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
+    try:
+        if label is not None:
+            wrapper.decisions.action(label)
+    except ValueError as error:
+        raise ValueError(f"config key 'imitation_decision': {error}") from None
+    finally:
+        wrapper.close()
     return decisions
 
 

@@ -2,14 +2,15 @@
 
     python -m agents.decisions_benchmark [--env ID ...] [--repeats R] [--per-instant]
 
-For each id, two policies: a fixed hold of 2^6 instants, and uniformly random decisions (the
-default decision set: holds 1..1024 and the paper's rule with its threshold scaled by 0.5, 1, 2
-or 4). Each figure is the median [min-max] of ``R`` timed runs after an untimed warm-up, in
-decisions per second and in env steps (sampling instants) per second, per second of wall time
-and per second of the process's CPU time (steadier on a shared machine); the env is the id's
-default scenario made by ``gym.make``, reset inside the timed loop when an episode ends.
-``--per-instant`` puts a plain ``gym.Wrapper`` between the decision wrapper and the env, so
-that every instant is one ``env.step`` call (the design before the compiled holds).
+For each id, three policies: a fixed hold of 2^6 instants, always "follow the paper" (the
+paper's rule at its own threshold), and uniformly random decisions (the default decision set:
+holds 1..1024 and the paper's rule with its threshold scaled by 0.5, 1, 2 or 4). Each figure
+is the median [min-max] of ``R`` timed runs after an untimed warm-up, in decisions per second
+and in env steps (sampling instants) per second, per second of wall time and per second of the
+process's CPU time (steadier on a shared machine); the env is the id's default scenario made by
+``gym.make``, reset inside the timed loop when an episode ends. ``--per-instant`` puts a plain
+``gym.Wrapper`` between the decision wrapper and the env, so that every instant is one
+``env.step`` call (the design before the compiled intervals).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from agents.decisions import SelfTriggeredWrapper
 DEFAULT_IDS = ("etsc/AttitudeTracking-v0", "etsc/InnerFormation-v0")
 HOLD_ACTION = 6
 """Hold 2^6 = 64 instants."""
-DECISIONS = {"hold": 3000, "random": 2000}
+DECISIONS = {"hold": 3000, "paper": 3000, "random": 2000}
 """Decisions per timed run."""
 RATES = ("decisions_per_s", "steps_per_s", "decisions_per_cpu_s", "steps_per_cpu_s")
 
@@ -35,13 +36,17 @@ RATES = ("decisions_per_s", "steps_per_s", "decisions_per_cpu_s", "steps_per_cpu
 def time_decisions(
     wrapper: SelfTriggeredWrapper, policy: str, decisions: int, seed: int
 ) -> tuple[float, float, int]:
-    """Wall and CPU seconds taken by ``decisions`` decisions of ``policy`` (``"hold"`` or
-    ``"random"``), and the env steps they ran."""
+    """Wall and CPU seconds taken by ``decisions`` decisions of ``policy`` (``"hold"``,
+    ``"paper"`` or ``"random"``), and the env steps they ran."""
     rng = np.random.default_rng(seed)
     n_actions = int(wrapper.action_space.n)
+    fixed = {
+        "hold": HOLD_ACTION,
+        "paper": wrapper.decisions.n_holds + wrapper.decisions.factors.index(1.0),
+    }
     actions = (
-        np.full(decisions, HOLD_ACTION)
-        if policy == "hold"
+        np.full(decisions, fixed[policy])
+        if policy in fixed
         else rng.integers(0, n_actions, size=decisions)
     )
     wrapper.reset(seed=seed)

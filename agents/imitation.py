@@ -12,6 +12,11 @@ returns that rule earns; PPO then trades transmissions against accuracy from the
 scenarios, through the same normalisation wrapper, whose statistics it thereby initialises),
 then trains the policy's action head to reproduce its decisions (cross-entropy) and the value
 head to predict the discounted returns of the collected episodes.
+
+:func:`imitate_decision` does the same for self-triggered decisions
+(:class:`agents.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
+the set (the better of the paper's rule at some threshold and the best clock, chosen on the
+validation set), and returns are discounted by the instants each decision lasted.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
 from baselines.cli import episode_setup
+from baselines.self_triggered import DecisionSet
 
 
 def paper_trigger(env_id: str, env_kwargs: dict[str, Any]) -> Any:
@@ -43,26 +49,29 @@ def collect_demonstrations(
 
     Returns the observations the learner sees (normalised if ``env`` normalises), the
     policy's actions, and the discounted returns from each transition to the end of its
-    episode or of the collection.
+    episode or of the collection (a transition whose info gives ``elapsed_steps`` = n, a
+    self-triggered decision, discounts what follows by ``gamma**n``).
     """
     rollout = max(steps // env.num_envs, 1)
     observation = env.reset()
     episode_start = np.ones(env.num_envs, dtype=bool)
     state = None
-    observations, actions, rewards, dones = [], [], [], []
+    observations, actions, rewards, dones, discounts = [], [], [], [], []
     for _ in range(rollout):
         raw = env.get_original_obs() if isinstance(env, VecNormalize) else observation
         action, state = policy.predict(raw, state=state, episode_start=episode_start)
         observations.append(observation)
         actions.append(action)
-        observation, reward, done, _ = env.step(action)
+        observation, reward, done, infos = env.step(action)
         rewards.append(reward)
         dones.append(done)
+        elapsed = np.array([info.get("elapsed_steps", 1) for info in infos], dtype=np.float64)
+        discounts.append(gamma**elapsed)
         episode_start = done
     returns = np.zeros((rollout, env.num_envs), dtype=np.float32)
     following = np.zeros(env.num_envs, dtype=np.float32)
     for index in range(rollout - 1, -1, -1):
-        following = rewards[index] + gamma * following * (1.0 - dones[index])
+        following = rewards[index] + discounts[index] * following * (1.0 - dones[index])
         returns[index] = following
     return (
         np.concatenate(observations),
@@ -78,10 +87,14 @@ def clone(
     returns: np.ndarray,
     epochs: int,
     batch_size: int,
+    separate_heads: bool = False,
 ) -> dict[str, float]:
     """Fit ``model``'s policy to the demonstrated ``actions`` (negative log-likelihood) and its
     value head to ``returns`` (squared error, weighted as PPO's ``vf_coef``), with the model's
-    own optimiser. Returns the last epoch's mean losses and the policy's agreement with the
+    own optimiser. With ``separate_heads`` each loss takes its own clipped gradient step per
+    batch (self-triggered decisions: their returns, sums over whole intervals, are large
+    enough at the start that the value loss's gradient would use up the clipped norm of a
+    joint step). Returns the last epoch's mean losses and the policy's agreement with the
     demonstrations (deterministic actions)."""
     policy = model.policy
     policy.set_training_mode(True)
@@ -106,11 +119,16 @@ def clone(
             )
             action_loss = -log_prob.mean()
             value_loss = torch.nn.functional.mse_loss(values.flatten(), return_tensor[batch])
-            loss = action_loss + value_weight * value_loss
-            policy.optimizer.zero_grad()
-            loss.backward()
-            torch.nn.utils.clip_grad_norm_(policy.parameters(), model.max_grad_norm)
-            policy.optimizer.step()
+            losses_to_step = (
+                [action_loss, value_weight * value_loss]
+                if separate_heads
+                else [action_loss + value_weight * value_loss]
+            )
+            for loss in losses_to_step:
+                policy.optimizer.zero_grad()
+                loss.backward()
+                torch.nn.utils.clip_grad_norm_(policy.parameters(), model.max_grad_norm)
+                policy.optimizer.step()
             sums["action_loss"] += action_loss.item() * len(batch)
             sums["value_loss"] += value_loss.item() * len(batch)
         losses = {name: total / count for name, total in sums.items()}
@@ -137,3 +155,36 @@ def imitate_paper_trigger(
         "demonstrated_transmit_rate": float(np.mean(actions)),
         **summary,
     }
+
+
+class FixedDecision:
+    """The demonstrator of :func:`imitate_decision`: one decision, always (SB3's ``predict``)."""
+
+    def __init__(self, action: int) -> None:
+        self.action = int(action)
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        return np.full(len(observation), self.action, dtype=np.int64), state
+
+
+def imitate_decision(
+    model: BaseAlgorithm, decisions: DecisionSet, label: str, steps: int, epochs: int
+) -> dict[str, Any]:
+    """Clone the decision ``label`` of ``decisions`` (``"paper x0.25"``, ``"hold 64"``) into
+    ``model``, a learner of self-triggered decisions, from ``steps`` decisions on its own
+    training env; returns the fit's summary."""
+    action = decisions.action(label)
+    env = model.get_env()
+    gamma = float(getattr(model, "gamma", 0.99))
+    observations, actions, returns = collect_demonstrations(
+        env, FixedDecision(action), steps, gamma
+    )
+    batch_size = int(getattr(model, "batch_size", 256))
+    summary = clone(model, observations, actions, returns, epochs, batch_size, separate_heads=True)
+    return {"steps": len(observations), "decision": label, **summary}

@@ -62,7 +62,7 @@ from agents.elapsed_discount import (
     MaskableElapsedRolloutBuffer,
 )
 from agents.evaluation import PaperComparisonCallback
-from agents.imitation import imitate_paper_trigger
+from agents.imitation import imitate_decision, imitate_paper_trigger
 from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
 from baselines.policies import ENV_ID_ATTRIBUTE, normalization_path
 from baselines.self_triggered import DecisionSet
@@ -166,7 +166,15 @@ def _train(
     if checkpoint is None:
         if config.checkpoint_every:
             _write_config(config, out_dir / CHECKPOINT_DIR / RUN_FILE)
-        if config.imitation_steps:
+        if config.imitation_steps and decisions is not None:
+            imitation = imitate_decision(
+                model,
+                decisions,
+                str(config.imitation_decision),
+                config.imitation_steps,
+                config.imitation_epochs,
+            )
+        elif config.imitation_steps:
             imitation = imitate_paper_trigger(
                 model,
                 config.env_id,

@@ -128,6 +128,13 @@ class DecisionSet:
             return f"hold {int(self.hold_steps[action])}"
         return f"paper x{self.factors[action - self.n_holds]:g}"
 
+    def action(self, label: str) -> int:
+        """The action :meth:`label` names ``label``; ``ValueError`` listing the labels if none."""
+        labels = [self.label(action) for action in range(self.action_space.n)]
+        if label not in labels:
+            raise ValueError(f"{label!r} is not a decision of this set; its decisions: {labels}")
+        return labels.index(label)
+
     def save(self, model_path: str | Path) -> Path:
         """Write the set beside the model saved at ``model_path`` (:func:`decision_set_path`)."""
         path = decision_set_path(model_path)

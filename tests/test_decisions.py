@@ -301,6 +301,16 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ({"decisions": {"max_exponent": 3, "holds": 2}}, "'decisions'"),
         ({"decisions": {"shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
         ({"decisions": {}, "imitation_steps": 64}, "imitation_steps"),
+        ({"decisions": {}, "imitation_decision": "hold 1"}, "imitation_steps"),
+        ({"imitation_decision": "hold 1"}, "'imitation_decision' needs the key 'decisions'"),
+        (
+            {
+                "decisions": {"max_exponent": 3},
+                "imitation_steps": 8,
+                "imitation_decision": "hold 64",
+            },
+            r"'imitation_decision': 'hold 64' is not a decision of this set",
+        ),
     ],
 )
 def test_training_config_checks_the_decisions(tmp_path, changes, message):
@@ -316,3 +326,35 @@ def test_training_config_checks_the_decisions(tmp_path, changes, message):
     }
     with pytest.raises(ValueError, match=message):
         config_from_dict({**config, **changes})
+
+
+def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
+    """Behaviour cloning of one decision ("follow the paper at half its threshold") before
+    reinforcement: the cloned policy takes that decision on the demonstrations."""
+    import yaml
+
+    from agents.train import main
+
+    out_dir = tmp_path / "run"
+    config = {
+        "env_id": FORMATION,
+        "env_kwargs": {"horizon_s": 0.2},
+        "algorithm": "PPO",
+        "policy": "MlpPolicy",
+        "hyperparameters": {"n_steps": 32, "batch_size": 32, "n_epochs": 1, "gamma": 0.999},
+        "total_timesteps": 32,
+        "n_envs": 2,
+        "out_dir": str(out_dir),
+        "decisions": {"max_exponent": 3},
+        "imitation_steps": 256,
+        "imitation_epochs": 60,
+        "imitation_decision": "paper x0.5",
+        "tensorboard": False,
+    }
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    assert main(["--config", str(path)]) == 0
+    summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    imitation = summary["imitation"]
+    assert imitation["decision"] == "paper x0.5" and imitation["steps"] == 256
+    assert imitation["agreement"] >= 0.95  # chance: 1 in 8
