@@ -18,10 +18,12 @@ from baselines.evaluate import evaluate
 from baselines.policies import load_sb3, takes_action_masks
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
 from etsc_envs.triggers import PAPER_TRIGGERS, PeriodicPolicy
+from etsc_envs.triggers.asteroid import AsteroidShield
 from etsc_envs.triggers.inner_formation import InnerFormationShield
 
 ATTITUDE = "etsc/AttitudeTracking-v0"
 FORMATION = "etsc/InnerFormation-v0"
+ASTEROID = "etsc/AsteroidOrbitKeeping-v0"
 HORIZON_S = 0.4
 SEED = 3
 
@@ -165,10 +167,13 @@ def test_a_time_limit_sees_every_instant_of_a_hold():
     assert "episode_metrics" not in info  # the time limit, not the env's horizon, cut it
 
 
-def test_shield_lets_no_forbidden_hold_through():
+@pytest.mark.parametrize(
+    ("env_id", "make_kwargs"), [(FORMATION, {}), (ASTEROID, {"horizon_s": 3000.0})]
+)
+def test_shield_lets_no_forbidden_hold_through(env_id, make_kwargs):
     kwargs = {"max_exponent": 10, "shield_multiple": 0.5}
-    n_actions = DecisionSet(FORMATION, max_exponent=10).action_space.n
-    base = recorded(FORMATION)
+    n_actions = DecisionSet(env_id, max_exponent=10).action_space.n
+    base = RecordedActions(gym.make(env_id, **{"horizon_s": HORIZON_S, **make_kwargs}))
     wrapper = SelfTriggeredWrapper(base, **kwargs)
     wrapper.reset(seed=SEED)
     longest_hold, largest_factor = 10, n_actions - 1
@@ -194,6 +199,20 @@ def test_shield_forbids_holds_that_outrun_the_threshold():
     allowed = shield.allowed_holds(obs, np.array([1, 16, 32]))
     np.testing.assert_array_equal(allowed, [[True, True, True], [True, True, False]])
     np.testing.assert_array_equal(shield.allowed_factors(np.array([1.0, 2.0, 4.0])), [1, 1, 0])
+
+
+def test_asteroid_shield_forbids_holds_that_leave_the_shell():
+    env = gym.make(ASTEROID)
+    names = env.unwrapped.observation_names
+    shield = AsteroidShield(names, 0.25, multiple=1.0)
+    obs = np.zeros((3, len(names)))
+    obs[:, names.index("radius_m")] = (200.0, 203.0, 197.0)
+    obs[:, names.index("radial_velocity_mps")] = (0.0, 0.1, -0.1)  # 2 m in 20 s = 80 instants
+    allowed = shield.allowed_holds(obs, np.array([1, 64, 128]))
+    np.testing.assert_array_equal(
+        allowed, [[True, True, True], [True, True, False], [True, True, False]]
+    )
+    np.testing.assert_array_equal(shield.allowed_factors(np.array([0.0625, 4.0])), [1, 1])
 
 
 def test_wrapper_passes_gymnasium_check_env():
