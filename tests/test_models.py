@@ -14,12 +14,13 @@ from baselines.evaluate import evaluate
 from baselines.policies import NormalizedModel, load_sb3, normalization_path
 
 ROOT = Path(__file__).parents[1]
-MODELS = sorted((ROOT / "models").glob("*_ppo.zip"))
+MODELS = sorted((ROOT / "models").glob("*-v0_*.zip"))
+"""``models/<id>_<method>.zip``: per-instant PPO (``_ppo``) and self-triggered decisions."""
 RESULTS = ROOT / "docs" / "results"
 
 
 def env_id_of(model: Path) -> str:
-    return "etsc/" + model.name.removesuffix("_ppo.zip")
+    return "etsc/" + model.name.partition("_")[0]
 
 
 def short_episode(env_id: str) -> dict[str, float]:
