@@ -15,7 +15,9 @@ its scenarios at once in the native vector env) and on the paper scenario:
   to reach periods at which the clock fails;
 * each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
   typically one per transmission penalty λ, and the model of every finished trial of each
-  ``--sweep`` (the results folder of ``python -m agents.sweep``: a front in one option).
+  ``--sweep`` (the results folder of ``python -m agents.sweep``: a front in one option). The
+  ``--model`` points form one method, ``learned``; each sweep is a method of its own, named
+  after its folder, and drawn as its own curve.
 
 A point records the set's aggregates (mean ``mean_cost`` and transmissions with 95 % bootstrap
 intervals, failures) and the paper scenario's episode. The plot shows each curve's
@@ -147,10 +149,15 @@ def pareto(
     scenarios: str = "test",
     set_size: int = DEFAULT_SET_SIZE,
     reuse: dict[str, Any] | None = None,
+    methods: list[str] | None = None,
 ) -> dict[str, Any]:
     """The three curves of the module docstring for ``env_id``; with ``reuse`` (an earlier
     result of the same id, kwargs and scenario set), its paper and periodic curves are kept and
-    only the models run."""
+    only the models run. ``methods`` names each model's method (the plot draws each method as
+    its own curve; default one method, ``learned``)."""
+    methods = list(methods) if methods is not None else [LEARNED] * len(models)
+    if len(methods) != len(models):
+        raise ValueError(f"methods: one per model ({len(models)}), got {len(methods)}")
     if env_id not in PAPER_SWEEPS:
         raise ValueError(f"no Pareto sweep for {env_id}; known: {sorted(PAPER_SWEEPS)}")
     if scenarios not in ("test", "validation"):
@@ -179,7 +186,10 @@ def pareto(
         }
     else:
         curves = {name: reuse["curves"][name] for name in ("paper", "periodic")}
-    curves["learned"] = [point(f"sb3:{path}", {}) for path in models]
+    curves["learned"] = [
+        {**point(f"sb3:{path}", {}), "method": method}
+        for path, method in zip(models, methods, strict=True)
+    ]
     return {
         "env": env_id,
         "env_kwargs": env_kwargs,
@@ -200,17 +210,34 @@ def non_dominated(points: list[dict[str, Any]], cost: Any, sent: Any) -> list[di
     return front
 
 
+LEARNED = "learned"
+"""The method of a learned point that names none (results written before methods existed)."""
+
 STYLES = {
     "paper": ("o", "-", "C0", "paper trigger (threshold sweep)"),
     "periodic": ("s", "--", "C1", "periodic (clock)"),
-    "learned": ("*", ":", "C3", "learned"),
 }
+LEARNED_STYLES = [("*", ":", "C3"), ("D", ":", "C2"), ("^", ":", "C4"), ("v", ":", "C5")]
+"""Marker, line and colour of each learned method in turn."""
+
+
+def series(result: dict[str, Any]) -> list[tuple[tuple[str, str, str, str], list[dict]]]:
+    """The curves to draw: the paper sweep, the periodic sweep, then one per learned method
+    (in order of appearance), each with its (marker, line, colour, label)."""
+    drawn = [(STYLES[name], result["curves"][name]) for name in STYLES]
+    learned = result["curves"].get("learned", [])
+    methods = list(dict.fromkeys(point.get("method", LEARNED) for point in learned))
+    for index, method in enumerate(methods):
+        marker, line, color = LEARNED_STYLES[index % len(LEARNED_STYLES)]
+        points = [point for point in learned if point.get("method", LEARNED) == method]
+        drawn.append(((marker, line, color, method), points))
+    return drawn
 
 
 def _draw_set(axes: plt.Axes, result: dict[str, Any]) -> None:
     """Means with interval bars; fronts joined, dominated points faint, failures crossed."""
-    for name, points in result["curves"].items():
-        marker, line, color, _ = STYLES[name]
+    for (marker, line, color, label), points in series(result):
+        learned = label not in {style[3] for style in STYLES.values()}
         usable = [p for p in points if p["transmissions"]["mean"] > 0]
         failed = [p for p in usable if p["failures"]]
         finished = [p for p in usable if not p["failures"]]
@@ -228,7 +255,7 @@ def _draw_set(axes: plt.Axes, result: dict[str, Any]) -> None:
                 fmt=marker + (line if group is front else ""),
                 color=color,
                 alpha=alpha,
-                markersize=9 if name == "learned" else 5,
+                markersize=9 if learned else 5,
                 capsize=2,
                 linewidth=1.2,
             )
@@ -250,8 +277,8 @@ def _bars(summaries: list[dict[str, Any]]) -> list[list[float]]:
 
 
 def _draw_paper_scenario(axes: plt.Axes, result: dict[str, Any]) -> None:
-    for name, points in result["curves"].items():
-        marker, line, color, _ = STYLES[name]
+    for (marker, line, color, label), points in series(result):
+        learned = label not in {style[3] for style in STYLES.values()}
         scenario = [p["paper_scenario"] for p in points if p["paper_scenario"]["transmissions"]]
         finished = [p for p in scenario if p["failure"] is None]
         front = non_dominated(finished, lambda p: p["mean_cost"], lambda p: p["transmissions"])
@@ -267,7 +294,7 @@ def _draw_paper_scenario(axes: plt.Axes, result: dict[str, Any]) -> None:
             [p["mean_cost"] for p in front],
             marker + line,
             color=color,
-            markersize=9 if name == "learned" else 5,
+            markersize=9 if learned else 5,
         )
         failed = [p for p in scenario if p["failure"] is not None]
         axes.plot(
@@ -316,7 +343,7 @@ def plot(result: dict[str, Any], path: Path) -> None:
     right.set_title("paper scenario", fontsize=10)
     handles = [
         plt.Line2D([], [], marker=marker, linestyle=line, color=color, label=label)
-        for marker, line, color, label in STYLES.values()
+        for (marker, line, color, label), _ in series(result)
     ]
     handles.append(plt.Line2D([], [], marker="x", linestyle="", color="k", label="with failures"))
     figure.legend(handles=handles, loc="lower center", ncol=4, frameon=False)
@@ -359,8 +386,14 @@ def main(argv: list[str] | None = None) -> int:
         require_writable_folder(out_dir, "--out")
         env_kwargs = parse_assignments(args.env_arg, "--env-arg")
         reuse = json.loads(args.reuse.read_text(encoding="utf-8")) if args.reuse else None
-        models = args.model + sweep_models(args.sweep, args.env_id)
-        result = pareto(args.env_id, models, env_kwargs, args.scenarios, args.set_size, reuse)
+        models, methods = list(args.model), [LEARNED] * len(args.model)
+        for results_dir in args.sweep:
+            found = sweep_models([results_dir], args.env_id)
+            models += found
+            methods += [Path(results_dir).name] * len(found)
+        result = pareto(
+            args.env_id, models, env_kwargs, args.scenarios, args.set_size, reuse, methods
+        )
     except (ValueError, TypeError, OSError, gym.error.Error) as error:
         parser.error(str(error))
     write_json(result, str(out_dir / "pareto.json"))
