@@ -64,6 +64,9 @@ class PaperComparisonCallback(BaseCallback):
         decisions: the decision set of a model trained on self-triggered decisions (it is
             evaluated as :class:`~baselines.self_triggered.SelfTriggeredPolicy` and saved with
             the set beside it), or ``None``.
+        evaluate_at_start: also evaluate the policy training starts from (timesteps 0), so
+            that a run started from a cloned or earlier policy can keep it as its best model
+            when reinforcement only makes it worse.
 
     Logged (TensorBoard and SB3's logger): ``eval/mean_cost``, ``eval/transmissions``,
     ``eval/return`` and the paper trigger's ``eval/paper_mean_cost``,
@@ -79,8 +82,10 @@ class PaperComparisonCallback(BaseCallback):
         set_size: int,
         best_model_path: str | Path | None = None,
         decisions: DecisionSet | None = None,
+        evaluate_at_start: bool = False,
     ) -> None:
         super().__init__()
+        self.evaluate_at_start = evaluate_at_start
         self.env_id = env_id
         self.scenarios = scenario_set("validation", set_size)
         base = {key: value for key, value in env_kwargs.items() if key != "randomize"}
@@ -109,6 +114,8 @@ class PaperComparisonCallback(BaseCallback):
         self.paper = set_summary(self._run(paper_trigger))
         self._next_evaluation = self.num_timesteps + self.every
         self._started = time.perf_counter()
+        if self.evaluate_at_start and not self.evaluations:
+            self._evaluate()
 
     def _on_step(self) -> bool:
         infos = self.locals.get("infos") or ()
@@ -116,6 +123,11 @@ class PaperComparisonCallback(BaseCallback):
         if self.num_timesteps < self._next_evaluation:
             return True
         self._next_evaluation += self.every
+        self._evaluate()
+        return True
+
+    def _evaluate(self) -> None:
+        """Run the current policy on the validation scenarios; record, log, keep the best."""
         learned = set_summary(self._run(self._current_policy()))
         self.evaluations.append(
             {
@@ -135,7 +147,6 @@ class PaperComparisonCallback(BaseCallback):
             self.best_return = learned["return"]
             self._save_best()
         atomic_write_text(self.out_path, json.dumps(to_jsonable(self.evaluations), indent=2) + "\n")
-        return True
 
     def restore(self, history: list[dict[str, Any]]) -> None:
         """Continue an interrupted run: keep its evaluations (up to the resumed checkpoint)

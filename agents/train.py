@@ -484,6 +484,7 @@ def _periodic_callbacks(
             config.evaluation_scenarios,
             out_dir / BEST_MODEL_FILE,
             decisions,
+            evaluate_at_start=bool(config.imitation_steps or config.init_from),
         )
         if checkpoint is not None:
             evaluation.restore(_previous_evaluations(out_dir, checkpoint))

@@ -349,7 +349,8 @@ def test_training_config_checks_the_decisions(tmp_path, changes, message):
 
 def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
     """Behaviour cloning of one decision ("follow the paper at half its threshold") before
-    reinforcement: the cloned policy takes that decision on the demonstrations."""
+    reinforcement: the cloned policy takes that decision on the demonstrations, and is
+    validated before reinforcement starts."""
     import yaml
 
     from agents.train import main
@@ -368,6 +369,9 @@ def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
         "imitation_steps": 256,
         "imitation_epochs": 60,
         "imitation_decision": "paper x0.5",
+        "evaluation_every": 32,
+        "evaluation_scenarios": 2,
+        "evaluation_env_kwargs": {"horizon_s": 0.1},
         "tensorboard": False,
     }
     path = tmp_path / "config.yaml"
@@ -377,3 +381,7 @@ def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
     imitation = summary["imitation"]
     assert imitation["decision"] == "paper x0.5" and imitation["steps"] == 256
     assert imitation["agreement"] >= 0.95  # chance: 1 in 8
+    # the cloned policy itself is validated first, so that it can be the best model
+    evaluations = json.loads((out_dir / "evaluations.json").read_text(encoding="utf-8"))
+    assert [entry["timesteps"] for entry in evaluations] == [0, 32, 64]  # 2 envs x 32 steps
+    assert (out_dir / "best_model.zip").is_file()
