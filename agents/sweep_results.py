@@ -29,6 +29,7 @@ SUMMARY_FILE = "sweep_summary.json"
 SETTINGS_FILE = "sweep_settings.json"
 TRIALS_DIR = "trials"
 MODEL_FILE = "model.zip"
+BEST_MODEL_FILE = "best_model.zip"
 EVALUATIONS_FILE = "evaluations.json"
 TRAIN_SUMMARY_FILE = "train_summary.json"
 CONFIG_FILE = "config.yaml"
@@ -108,8 +109,11 @@ class SweepTrial:
 
     @property
     def model(self) -> Path:
-        """The trial's saved model (its normalisation statistics lie beside it)."""
-        return self.folder / MODEL_FILE
+        """The model the trial is judged by (its normalisation statistics lie beside it): the
+        checkpoint of the best validation return (``best_model.zip``) where the run validated,
+        since the protocol chooses checkpoints on the validation set; else the final model."""
+        best = self.folder / BEST_MODEL_FILE
+        return best if best.is_file() else self.folder / MODEL_FILE
 
     def record(self, results_dir: Path) -> dict[str, Any]:
         """The trial's entry in ``sweep_summary.json`` (folder relative to ``results_dir``)."""

@@ -90,7 +90,11 @@ def test_the_summary_reads_back_and_only_finished_trials_count(tmp_path: Path) -
     assert [trial.status for trial in trials] == ["finished", "failed"]
     assert trials[1].error.startswith("ValueError: transmission_penalty")
     (finished,) = finished_trials(tmp_path / "sweep", ENV_ID)
-    assert finished.model == tmp_path / "sweep" / "trials" / "transmission_penalty=30" / "model.zip"
+    folder = tmp_path / "sweep" / "trials" / "transmission_penalty=30"
+    assert finished.model == folder / "model.zip"
+    (folder / "best_model.zip").write_bytes(b"")  # a run that validated: its best checkpoint
+    (finished,) = finished_trials(tmp_path / "sweep", ENV_ID)
+    assert finished.model == folder / "best_model.zip"
     with pytest.raises(ValueError, match="trained 'etsc/AttitudeTracking-v0', not"):
         finished_trials(tmp_path / "sweep", "etsc/InnerFormation-v0")
     with pytest.raises(ValueError, match=r"holds no sweep_summary\.json"):
