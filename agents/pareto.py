@@ -235,8 +235,9 @@ def series(result: dict[str, Any]) -> list[tuple[tuple[str, str, str, str], list
 
 
 def _draw_set(axes: plt.Axes, result: dict[str, Any]) -> None:
-    """Means with interval bars; fronts joined, dominated points faint, failures crossed."""
-    for (marker, line, color, label), points in series(result):
+    """Means with interval bars; fronts joined, dominated points faint, failures crossed (the
+    learned methods first, so that the baselines' smaller markers stay visible on them)."""
+    for (marker, line, color, label), points in reversed(series(result)):
         learned = label not in {style[3] for style in STYLES.values()}
         usable = [p for p in points if p["transmissions"]["mean"] > 0]
         failed = [p for p in usable if p["failures"]]
@@ -277,7 +278,7 @@ def _bars(summaries: list[dict[str, Any]]) -> list[list[float]]:
 
 
 def _draw_paper_scenario(axes: plt.Axes, result: dict[str, Any]) -> None:
-    for (marker, line, color, label), points in series(result):
+    for (marker, line, color, label), points in reversed(series(result)):
         learned = label not in {style[3] for style in STYLES.values()}
         scenario = [p["paper_scenario"] for p in points if p["paper_scenario"]["transmissions"]]
         finished = [p for p in scenario if p["failure"] is None]
