@@ -38,9 +38,9 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode
-from tqdm import tqdm
 
 import etsc_envs
+from baselines.episodes import instants_bar
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.vector_env import available_cores
 from etsc_envs.triggers.base import RuleTrigger
@@ -196,18 +196,6 @@ def _run(
     return records
 
 
-def _progress_bar(total: int, shown: bool, description: str) -> tqdm:
-    """The progress bar over a batch's sampling instants."""
-    return tqdm(
-        total=total,
-        disable=not shown,
-        desc=description,
-        unit="step",
-        leave=False,
-        mininterval=0.5,
-    )
-
-
 def _run_rule(
     vector_env: Any,
     trigger: RuleTrigger,
@@ -227,7 +215,7 @@ def _run_rule(
         )
     totals = np.zeros(vector_env.num_envs)
     channel_totals = np.zeros((vector_env.num_envs, loop.n_channels))
-    with _progress_bar(loop.n_steps, progress, description) as bar:
+    with instants_bar(loop.n_steps, progress, description) as bar:
         while True:
             steps_run = vector_env.run_rule(trigger, PROGRESS_EVERY, totals, channel_totals)
             bar.update(int(steps_run.max()))
@@ -261,7 +249,7 @@ def _run_predict(
     state, episode_start = None, np.ones(rows * n_agents, dtype=bool)
     not_started = np.zeros(rows * n_agents, dtype=bool)
     steps = 0
-    with _progress_bar(loop.n_steps, progress, description) as bar:
+    with instants_bar(loop.n_steps, progress, description) as bar:
         while running.any():
             policy_input = (
                 observations[:, agent_index].reshape(rows * n_agents, -1)

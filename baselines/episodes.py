@@ -35,10 +35,11 @@ class EpisodeTrace:
         return np.array([sample[name] for sample in self.samples])
 
 
-def _episode_bar(unwrapped: Any, progress: bool, description: str) -> tqdm:
-    """A progress bar over one episode's sampling instants (hidden unless ``progress``)."""
+def instants_bar(total: int | None, progress: bool, description: str) -> tqdm:
+    """A progress bar over ``total`` sampling instants (hidden unless ``progress``), for one
+    episode here and for a batch of them in :mod:`baselines.batch`."""
     return tqdm(
-        total=getattr(unwrapped, "n_steps", None),
+        total=total,
         disable=not progress,
         desc=description,
         unit="step",
@@ -71,7 +72,7 @@ def run_episode(
     obs, _ = env.reset(seed=seed)
     state, episode_start = None, np.ones(1, dtype=bool)
     total_return, steps = 0.0, 0
-    bar = _episode_bar(unwrapped, progress, description)
+    bar = instants_bar(getattr(unwrapped, "n_steps", None), progress, description)
     started = time.perf_counter()
     if sampler is not None:
         trace.samples.append(sampler())
@@ -132,7 +133,7 @@ def run_parallel_episode(
     state, episode_start = None, np.ones(len(names), dtype=bool)
     returns = np.zeros(len(names))
     steps = 0
-    bar = _episode_bar(unwrapped, progress, description)
+    bar = instants_bar(getattr(unwrapped, "n_steps", None), progress, description)
     started = time.perf_counter()
     if sampler is not None:
         trace.samples.append(sampler())
