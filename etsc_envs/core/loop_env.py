@@ -53,6 +53,7 @@ from etsc_envs.core.validation import (
     require_non_negative,
     require_positive,
     require_reset_options,
+    require_rule_trigger,
     step_count,
 )
 
@@ -321,11 +322,7 @@ class EventTriggeredEnv(gym.Env):
         self._require_running("run_rule_interval")
         instants = require_int_at_least("instants", instants, 1)
         gamma = require_discount("gamma", gamma)
-        if getattr(trigger, "n_channels", None) != self.n_channels:
-            raise ValueError(
-                f"trigger must be a paper rule (RuleTrigger) with {self.n_channels} transmit "
-                f"bit(s), got {trigger!r}"
-            )
+        require_rule_trigger("trigger", trigger, self.n_channels)
         outputs = self._outputs_for(instants)
         outputs.discounted[:] = 0.0
         arguments = (

@@ -56,6 +56,18 @@ def require_discount(name: str, value: float) -> float:
     return value
 
 
+def require_rule_trigger(name: str, trigger: Any, n_channels: int) -> Any:
+    """``trigger`` if it is a paper rule (a ``RuleTrigger``: compiled ``rule`` with
+    ``rule_indices`` and ``rule_parameters``) writing ``n_channels`` transmit bits, else
+    ``ValueError`` naming ``name``."""
+    if getattr(trigger, "n_channels", None) != n_channels or not hasattr(trigger, "rule"):
+        raise ValueError(
+            f"{name} must be a paper rule (RuleTrigger) with {n_channels} transmit bit(s), "
+            f"got {trigger!r}"
+        )
+    return trigger
+
+
 def require_choice(name: str, value: str, choices: Iterable[str]) -> str:
     """``value``, or ``ValueError`` listing the allowed choices."""
     choices = tuple(choices)

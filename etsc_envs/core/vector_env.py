@@ -36,7 +36,7 @@ from etsc_envs.core.compiled_loop import (
 )
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.render import RENDER_MODES
-from etsc_envs.core.validation import require_reset_options
+from etsc_envs.core.validation import require_reset_options, require_rule_trigger
 
 ROWS_PER_THREAD_MIN = 8
 """A batch gets one more thread for every this many rows, up to one per available core
@@ -251,11 +251,7 @@ class EventTriggeredVectorEnv(VectorEnv):
         instants each row ran.
         """
         first = self.envs[0]
-        if getattr(trigger, "n_channels", None) != first.n_channels:
-            raise ValueError(
-                f"trigger must be a paper rule (RuleTrigger) with {first.n_channels} transmit "
-                f"bit(s), got {trigger!r}"
-            )
+        require_rule_trigger("trigger", trigger, first.n_channels)
         instants = int(instants)
         active = ~self._needs_reset
         steps_run = np.zeros(self.num_envs, dtype=np.int64)

@@ -6,6 +6,7 @@ import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
+from etsc_envs.core.validation import require_positive
 from etsc_envs.triggers.base import RuleTrigger
 
 PAPER_ALPHA = 0.05
@@ -86,15 +87,10 @@ class AsteroidShield:
         reference_radius_m: float = 200.0,
         shell_half_width_m: float = 5.0,
     ) -> None:
-        multiple = float(multiple)
-        if not np.isfinite(multiple) or multiple <= 0.0:
-            raise ValueError(f"multiple must be a finite number > 0, got {multiple!r}")
-        if not np.isfinite(sampling_period_s) or sampling_period_s <= 0.0:
-            raise ValueError(f"sampling_period_s must be > 0, got {sampling_period_s!r}")
-        self.multiple = multiple
-        self.sampling_period_s = float(sampling_period_s)
+        self.multiple = require_positive("multiple", multiple)
+        self.sampling_period_s = require_positive("sampling_period_s", sampling_period_s)
         self.reference_radius_m = float(reference_radius_m)
-        self.allowed_error_m = multiple * float(shell_half_width_m)
+        self.allowed_error_m = self.multiple * float(shell_half_width_m)
         self.radius_index = observation_names.index("radius_m")
         self.rate_index = observation_names.index("radial_velocity_mps")
 

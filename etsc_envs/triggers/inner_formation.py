@@ -6,6 +6,7 @@ import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
+from etsc_envs.core.validation import require_positive
 from etsc_envs.inner_formation.design import equal_share_thresholds
 from etsc_envs.inner_formation.params import InnerFormationParams
 from etsc_envs.triggers.base import RuleTrigger
@@ -105,13 +106,8 @@ class InnerFormationShield:
         multiple: float = PAPER_SHIELD_MULTIPLE,
         thresholds: np.ndarray | None = None,
     ) -> None:
-        multiple = float(multiple)
-        if not np.isfinite(multiple) or multiple <= 0.0:
-            raise ValueError(f"multiple must be a finite number > 0, got {multiple!r}")
-        if not np.isfinite(sampling_period_s) or sampling_period_s <= 0.0:
-            raise ValueError(f"sampling_period_s must be > 0, got {sampling_period_s!r}")
-        self.multiple = multiple
-        self.sampling_period_s = float(sampling_period_s)
+        self.multiple = require_positive("multiple", multiple)
+        self.sampling_period_s = require_positive("sampling_period_s", sampling_period_s)
         self.thresholds = default_thresholds() if thresholds is None else np.asarray(thresholds)
         self.velocity_indices = [
             observation_names.index(f"velocity_estimate_mps_{a}") for a in AXES
