@@ -18,7 +18,12 @@ A trial that raises is recorded as failed with its error and does not stop the o
 command writes ``sweep_summary.json`` and prints one line per trial; it exits with 1 when a
 trial failed, or when a front is incomplete, else 0.
 
-Needs the ``sweep`` extra (``pip install -e ".[train,sweep]"``).
+``--processes N`` runs a grid sweep (kinds ``front`` and ``grid``, no scheduler or search)
+without Ray, N trials at a time in worker processes on this machine
+(:mod:`agents.sweep_processes`); it writes the same results folder, and ``--resume`` continues
+it by running the trials that had not finished.
+
+Needs the ``sweep`` extra (``pip install -e ".[train,sweep]"``), except with ``--processes``.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ from urllib.parse import urlsplit
 import yaml
 
 from agents.sweep_config import SweepConfig, load_sweep_config
+from agents.sweep_processes import check_process_sweep, run_sweep_in_processes
 from agents.sweep_results import (
     SETTINGS_FILE,
     SweepTrial,
@@ -206,17 +212,9 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
 
     if resume and not tune.Tuner.can_restore(str(sweep.tune_dir)):
         raise ValueError(f"--resume: no saved sweep in {str(sweep.tune_dir)!r} to continue")
-    if not resume and (sweep.tune_dir.exists() or sweep.trials_dir.exists()):
-        raise ValueError(
-            f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
-            f"or choose another results_dir"
-        )
     if address is not None:
         check_reachable(address)
-    if resume:
-        _check_unchanged(sweep)
-    else:
-        atomic_write_text(Path(sweep.results_dir) / SETTINGS_FILE, _settings_json(sweep))
+    _start_or_continue(sweep, resume, sweep.tune_dir.exists() or sweep.trials_dir.exists())
     connect(address)
     try:
         results = build_tuner(sweep, resume).fit()
@@ -225,6 +223,22 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
     trials = summarize(sweep, results)
     write_summary(sweep.results_dir, _description(sweep), trials)
     return trials
+
+
+def _start_or_continue(sweep: SweepConfig, resume: bool, started: bool) -> None:
+    """Refuse to start over a sweep that has ``started`` (``--resume`` continues it, with the
+    settings it started with); record a new sweep's settings."""
+    if resume:
+        if not started:
+            raise ValueError(f"--resume: no sweep in {sweep.results_dir!r} to continue")
+        _check_unchanged(sweep)
+        return
+    if started:
+        raise ValueError(
+            f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
+            f"or choose another results_dir"
+        )
+    atomic_write_text(Path(sweep.results_dir) / SETTINGS_FILE, _settings_json(sweep))
 
 
 def _settings_json(sweep: SweepConfig) -> str:
@@ -287,6 +301,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--resume", action="store_true", help="continue the interrupted sweep of the config"
     )
+    parser.add_argument(
+        "--processes",
+        type=int,
+        metavar="N",
+        help="run a grid sweep without Ray, N trials at a time in processes on this machine",
+    )
     return parser
 
 
@@ -294,6 +314,18 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line: validate the config, run the sweep, report its trials."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.processes is not None:
+        if args.address is not None:
+            parser.error("--address joins a Ray cluster; --processes runs without Ray")
+        try:
+            sweep = load_sweep_config(args.config)
+            require_writable_folder(sweep.results_dir, "results_dir")
+            check_process_sweep(sweep, args.processes)
+            _start_or_continue(sweep, args.resume, sweep.trials_dir.exists())
+            trials = run_sweep_in_processes(sweep, args.processes, _description(sweep))
+        except (OSError, ValueError, yaml.YAMLError) as error:
+            parser.error(str(error))
+        return _report(sweep, trials)
     try:
         import ray  # noqa: F401
         from ray import tune  # noqa: F401

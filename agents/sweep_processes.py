@@ -1,0 +1,98 @@
+"""A grid sweep on this machine's cores without Ray: every trial one ``agents.train`` run in a
+worker process of a process pool.
+
+``python -m agents.sweep --config configs/sweeps/NAME.yaml --processes N`` takes this path.
+It writes the same results folder as the Ray path (:mod:`agents.sweep_results`: the trials'
+folders, ``sweep_settings.json`` and ``sweep_summary.json``, no ``tune/``), so that
+``agents.results --sweep`` and ``agents.pareto --sweep`` read either. It runs grids only (kinds
+``front`` and ``grid`` without a scheduler or a search, which need Tune). A trial whose training
+had finished is not run again, so the same command continues an interrupted sweep; an
+unfinished trial starts again from its newest checkpoint where its config saves them.
+
+Workers are spawned, not forked: a forked child of a process that has run torch can deadlock
+in its OpenMP pool (the reason :mod:`baselines.batch` spawns too).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+from agents.sweep_config import SweepConfig
+from agents.sweep_results import (
+    EVALUATIONS_FILE,
+    SweepTrial,
+    final_scores,
+    training_finished,
+    trial_status,
+    write_summary,
+)
+from agents.train import CHECKPOINT_DIR, latest_checkpoint, train
+
+
+def check_process_sweep(sweep: SweepConfig, processes: int) -> None:
+    """``ValueError`` unless ``processes`` is a count >= 1 and the sweep is a grid that needs
+    no Tune scheduler or search."""
+    if isinstance(processes, bool) or not isinstance(processes, int) or processes < 1:
+        raise ValueError(f"--processes must be an integer >= 1, got {processes!r}")
+    if sweep.search or sweep.scheduler is not None or sweep.search_algorithm is not None:
+        raise ValueError(
+            "--processes runs grid sweeps only (no search, scheduler or search_algorithm); "
+            f"{sweep.path} needs Ray Tune: leave --processes out"
+        )
+
+
+def _run_trial(sweep: SweepConfig, values: dict[str, Any], folder: Path) -> str | None:
+    """Train one trial into ``folder`` (continuing from its newest checkpoint if it has one);
+    ``None`` on success, else the error as ``Type: first line``."""
+    try:
+        config = sweep.trial_config(values, folder)
+        resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
+        if not resume:  # an interrupted start's evaluations are not this run's
+            (folder / EVALUATIONS_FILE).unlink(missing_ok=True)
+        train(config, resume=resume)
+    except Exception as error:  # a failed trial is recorded, the others go on
+        lines = str(error).strip().splitlines()
+        return f"{type(error).__name__}: {lines[0]}" if lines else type(error).__name__
+    return None
+
+
+def run_sweep_in_processes(
+    sweep: SweepConfig, processes: int, description: dict[str, Any]
+) -> list[SweepTrial]:
+    """Run the grid's unfinished trials, ``processes`` at a time, write the summary (with
+    ``description``, the sweep's header) and return every trial in the grid's order."""
+    check_process_sweep(sweep, processes)
+    points = {sweep.trial_name(values): values for values in sweep.grid_points()}
+    pending = {
+        name: values
+        for name, values in points.items()
+        if not training_finished(sweep.trial_folder(name))
+    }
+    errors: dict[str, str | None] = {}
+    if pending:
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(min(processes, len(pending)), mp_context=context) as pool:
+            futures = {
+                name: pool.submit(_run_trial, sweep, values, sweep.trial_folder(name))
+                for name, values in pending.items()
+            }
+            errors = {name: future.result() for name, future in futures.items()}
+    trials = []
+    for name, values in points.items():
+        folder = sweep.trial_folder(name)
+        error = errors.get(name)
+        trials.append(
+            SweepTrial(
+                name=name,
+                values=values,
+                status=trial_status(folder, error),
+                error=error,
+                folder=folder,
+                scores=final_scores(folder) if error is None else None,
+            )
+        )
+    write_summary(sweep.results_dir, description, trials)
+    return trials

@@ -1,0 +1,125 @@
+"""``python -m agents.sweep --processes N``: the tiny front in worker processes with Ray made
+unimportable (two trials that train, one that crashes), continued with ``--resume``; and its
+refusals of what it cannot run."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+pytest.importorskip("stable_baselines3")
+
+ROOT = Path(__file__).resolve().parents[1]
+TINY = ROOT / "configs" / "sweeps" / "tiny.yaml"
+FINISHING = ("transmission_penalty=30", "transmission_penalty=100")
+CRASHING = "transmission_penalty=-1"
+
+
+def tiny_sweep(tmp_path: Path, **keys: Any) -> Path:
+    """``configs/sweeps/tiny.yaml`` with its results in ``tmp_path`` and ``keys`` replaced."""
+    raw = yaml.safe_load(TINY.read_text(encoding="utf-8"))
+    raw["base"] = str(ROOT / raw["base"])
+    raw["results_dir"] = str(tmp_path / "sweep")
+    raw.update(keys)
+    path = tmp_path / "sweep.yaml"
+    path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:
+    """The sweep command in a Python where ``import ray`` fails."""
+    code = (
+        "import sys\n"
+        "sys.modules['ray'] = None  # as if Ray were not installed\n"
+        "from agents.sweep import main\n"
+        f"raise SystemExit(main({list(arguments)!r}))\n"
+    )
+    return subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=900
+    )
+
+
+@pytest.fixture(scope="module")
+def process_sweep(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    tmp_path = tmp_path_factory.mktemp("process_sweep")
+    config = tiny_sweep(tmp_path, grid={"env_kwargs.transmission_penalty": [30.0, 100.0, -1.0]})
+    first = sweep_without_ray("--config", str(config), "--processes", "2")
+    results_dir = tmp_path / "sweep"
+    summary = json.loads((results_dir / "sweep_summary.json").read_text(encoding="utf-8"))
+    times = {
+        name: (results_dir / "trials" / name / "model.zip").stat().st_mtime_ns for name in FINISHING
+    }
+    resumed = sweep_without_ray("--config", str(config), "--processes", "1", "--resume")
+    return {
+        "config": config,
+        "results_dir": results_dir,
+        "first": first,
+        "summary": summary,
+        "times": times,
+        "resumed": resumed,
+    }
+
+
+def test_the_grid_trains_without_ray_and_records_the_crashing_trial(process_sweep) -> None:
+    first = process_sweep["first"]
+    assert first.returncode == 1, first.stderr
+    statuses = {trial["name"]: trial["status"] for trial in process_sweep["summary"]["trials"]}
+    assert statuses == {FINISHING[0]: "finished", FINISHING[1]: "finished", CRASHING: "failed"}
+    crashed = next(t for t in process_sweep["summary"]["trials"] if t["name"] == CRASHING)
+    assert "transmission_penalty must be a finite number >= 0" in crashed["error"]
+    for name in FINISHING:
+        folder = process_sweep["results_dir"] / "trials" / name
+        assert (folder / "model_vecnormalize.pkl").is_file()
+        assert json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
+    assert not (process_sweep["results_dir"] / "tune").exists()
+
+
+def test_resuming_trains_only_the_unfinished_trials(process_sweep) -> None:
+    resumed = process_sweep["resumed"]
+    assert resumed.returncode == 1, resumed.stderr
+    for name in FINISHING:
+        model = process_sweep["results_dir"] / "trials" / name / "model.zip"
+        assert model.stat().st_mtime_ns == process_sweep["times"][name]
+        assert f"finished   {name}" in resumed.stdout
+
+
+def test_the_results_tools_read_the_process_sweep(process_sweep) -> None:
+    from agents.sweep_results import read_sweep
+
+    trials = read_sweep(process_sweep["results_dir"])
+    assert sorted(t.name for t in trials if t.status == "finished") == sorted(FINISHING)
+
+
+def test_starting_again_over_a_sweep_is_refused(process_sweep) -> None:
+    again = sweep_without_ray("--config", str(process_sweep["config"]), "--processes", "1")
+    assert again.returncode == 2
+    assert "already holds a sweep: continue it with --resume" in again.stderr
+
+
+@pytest.mark.parametrize(
+    ("keys", "options", "message"),
+    [
+        (
+            {"kind": "search", "grid": {}, "search": {"seed": {"choice": [0, 1]}}},
+            ("--processes", "1"),
+            "--processes runs grid sweeps only",
+        ),
+        ({}, ("--processes", "0"), "--processes must be an integer >= 1, got 0"),
+        ({}, ("--processes", "1", "--address", "auto"), "--processes runs without Ray"),
+        ({}, ("--processes", "1", "--resume"), "--resume: no sweep in"),
+    ],
+)
+def test_what_processes_cannot_run_is_refused_in_one_line(
+    tmp_path: Path, keys: dict[str, Any], options: tuple[str, ...], message: str
+) -> None:
+    config = tiny_sweep(tmp_path, **keys)
+    run = sweep_without_ray("--config", str(config), *options)
+    assert run.returncode == 2
+    assert message in run.stderr.strip().splitlines()[-1]
+    assert not (tmp_path / "sweep" / "trials").exists()
