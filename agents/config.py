@@ -51,6 +51,11 @@ A config is a YAML mapping with these keys (the optional ones show their default
   (``"paper x0.25"``, ``"hold 64"``: :meth:`baselines.self_triggered.DecisionSet.label`;
   :func:`agents.imitation.imitate_decision`); needed with ``decisions`` and
   ``imitation_steps``, refused without ``decisions``;
+* ``imitation_heartbeat: null`` — with ``imitation_decision``, a number of instants H: the
+  demonstrator then chooses "hold 1" (transmit now) at a decision where the last
+  transmission lies H or more instants back, else ``imitation_decision`` — the paper's rule
+  paired with a heartbeat of period H when ``decisions.rule_cap`` is H
+  (:class:`agents.imitation.HeartbeatDecision`);
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
   ``shield_multiple``; its ``gamma`` is ``hyperparameters.gamma``), on a ``DummyVecEnv`` of
@@ -118,6 +123,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "imitation_steps": 0,
     "imitation_epochs": 10,
     "imitation_decision": None,
+    "imitation_heartbeat": None,
     "decisions": None,
 }
 
@@ -151,6 +157,7 @@ class TrainConfig:
     imitation_steps: int
     imitation_epochs: int
     imitation_decision: str | None
+    imitation_heartbeat: int | None
     decisions: dict[str, Any] | None
 
     @property
@@ -219,6 +226,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
         imitation_decision=values["imitation_decision"],
+        imitation_heartbeat=_check_heartbeat(values),
         decisions=decisions,
     )
 
@@ -259,6 +267,20 @@ def _check_algorithm(name: Any) -> str:
     return name
 
 
+def _check_heartbeat(values: Mapping[str, Any]) -> int | None:
+    """``values["imitation_heartbeat"]``: null, or instants >= 1 beside an imitation decision."""
+    heartbeat = values["imitation_heartbeat"]
+    if heartbeat is None:
+        return None
+    if isinstance(heartbeat, bool) or not isinstance(heartbeat, int) or heartbeat < 1:
+        raise ValueError(
+            f"config key 'imitation_heartbeat' must be an integer >= 1 or null, got {heartbeat!r}"
+        )
+    if values["imitation_decision"] is None:
+        raise ValueError("config key 'imitation_heartbeat' needs the key 'imitation_decision'")
+    return heartbeat
+
+
 def _check_decisions(
     values: Mapping[str, Any], algorithm: str, env_id: str, env_kwargs: dict[str, Any]
 ) -> dict[str, Any] | None:
@@ -280,7 +302,7 @@ def _check_decisions(
             "'decisions' (the decision to clone, and for how many decisions), got "
             f"imitation_steps={values['imitation_steps']!r}, imitation_decision={label!r}"
         )
-    allowed = ("max_exponent", "factors", "shield_multiple")
+    allowed = ("max_exponent", "factors", "shield_multiple", "rule_cap")
     unknown = sorted(set(decisions) - set(allowed))
     if unknown:
         raise ValueError(f"config key 'decisions': {unknown} are not among {list(allowed)}")

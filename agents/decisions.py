@@ -67,6 +67,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             :data:`etsc_envs.triggers.PAPER_SHIELDS`).
         gamma: the per-instant discount within an interval (in (0, 1]); the algorithm's
             ``gamma`` when it discounts by elapsed instants.
+        rule_cap: the longest "paper × f" interval in instants (``None``: 2^max_exponent).
     """
 
     def __init__(
@@ -76,6 +77,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         factors: tuple[float, ...] | None = None,
         shield_multiple: float | None = None,
         gamma: float = 0.99,
+        rule_cap: int | None = None,
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -83,6 +85,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             factors=factors,
             shield_multiple=shield_multiple,
             gamma=gamma,
+            rule_cap=rule_cap,
         )
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
@@ -95,6 +98,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             factors=default_factors(env.spec.id) if factors is None else tuple(factors),
             shield_multiple=shield_multiple,
             sampling_period_s=float(unwrapped.params.sampling_period_s),
+            rule_cap=rule_cap,
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names
@@ -131,7 +135,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         following = int(chosen[0]) - self.decisions.n_holds
         if following >= 0 and self._loop is not None:
             observation, total, terminated, truncated, info, steps = self._loop.run_rule_interval(
-                self.schedule.triggers[following], int(self.decisions.hold_steps[-1]), self.gamma
+                self.schedule.triggers[following], self.decisions.rule_steps, self.gamma
             )
         else:
             observation, total, terminated, truncated, info, steps = self._run_schedule(chosen)

@@ -16,7 +16,8 @@ head to predict the discounted returns of the collected episodes.
 :func:`imitate_decision` does the same for self-triggered decisions
 (:class:`agents.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
 the set (the better of the paper's rule at some threshold and the best clock, chosen on the
-validation set), and returns are discounted by the instants each decision lasted.
+validation set), or that decision paired with a heartbeat (:class:`HeartbeatDecision`), and
+returns are discounted by the instants each decision lasted.
 """
 
 from __future__ import annotations
@@ -173,18 +174,68 @@ class FixedDecision:
         return np.full(len(observation), self.action, dtype=np.int64), state
 
 
+class HeartbeatDecision:
+    """A demonstrator of :func:`imitate_decision`: ``action``, except "hold 1" (action 0:
+    transmit now, decide again at the next instant) where the last transmission lies
+    ``heartbeat`` instants or more back (on the stalest channel, read from the observations'
+    ``time_since_transmission_s`` entries). With the decision set's ``rule_cap`` equal to
+    ``heartbeat`` and ``action`` a "paper × f", this is the rule paired with a heartbeat: a
+    transmission when the rule fires or when ``heartbeat`` instants passed without one."""
+
+    def __init__(
+        self,
+        action: int,
+        heartbeat: int,
+        observation_names: tuple[str, ...],
+        sampling_period_s: float,
+    ) -> None:
+        self.action = int(action)
+        self.columns = [
+            index
+            for index, name in enumerate(observation_names)
+            if name.startswith("time_since_transmission_s")
+        ]
+        if not self.columns:
+            raise ValueError(
+                "imitation_heartbeat: the observations hold no time_since_transmission_s"
+            )
+        # half an instant below H periods, so that rounding of the clock cannot miss it
+        self.threshold_s = (heartbeat - 0.5) * sampling_period_s
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        silent_s = np.asarray(observation)[:, self.columns].max(axis=1)
+        return np.where(silent_s >= self.threshold_s, 0, self.action).astype(np.int64), state
+
+
 def imitate_decision(
-    model: BaseAlgorithm, decisions: DecisionSet, label: str, steps: int, epochs: int
+    model: BaseAlgorithm,
+    decisions: DecisionSet,
+    label: str,
+    steps: int,
+    epochs: int,
+    heartbeat: int | None = None,
 ) -> dict[str, Any]:
     """Clone the decision ``label`` of ``decisions`` (``"paper x0.25"``, ``"hold 64"``) into
     ``model``, a learner of self-triggered decisions, from ``steps`` decisions on its own
-    training env; returns the fit's summary."""
+    training env, paired with a ``heartbeat`` of that many instants if given
+    (:class:`HeartbeatDecision`); returns the fit's summary."""
     action = decisions.action(label)
     env = model.get_env()
     gamma = float(getattr(model, "gamma", 0.99))
-    observations, actions, returns = collect_demonstrations(
-        env, FixedDecision(action), steps, gamma
-    )
+    demonstrator: Any = FixedDecision(action)
+    if heartbeat is not None:
+        names = tuple(env.get_attr("observation_names", [0])[0])
+        demonstrator = HeartbeatDecision(
+            action, heartbeat, names, float(decisions.sampling_period_s)
+        )
+    observations, actions, returns = collect_demonstrations(env, demonstrator, steps, gamma)
     batch_size = int(getattr(model, "batch_size", 256))
     summary = clone(model, observations, actions, returns, epochs, batch_size, separate_heads=True)
-    return {"steps": len(observations), "decision": label, **summary}
+    described = label if heartbeat is None else f"{label}, heartbeat {heartbeat}"
+    return {"steps": len(observations), "decision": described, **summary}

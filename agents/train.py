@@ -173,6 +173,7 @@ def _train(
                 str(config.imitation_decision),
                 config.imitation_steps,
                 config.imitation_epochs,
+                heartbeat=config.imitation_heartbeat,
             )
         elif config.imitation_steps:
             imitation = imitate_paper_trigger(

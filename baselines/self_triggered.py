@@ -8,8 +8,8 @@ An action of :class:`DecisionSet` is one of
 * **paper × f**: the paper's trigger with its threshold keywords
   (:data:`etsc_envs.triggers.PAPER_THRESHOLDS`) scaled by f decides every instant, the
   decision instant included; the interval ends just before a later instant at which it fires
-  (on any channel), after 2^k instants, or with the episode. Always choosing f = 1 is the
-  paper's trigger.
+  (on any channel), after 2^k instants (or the set's ``rule_cap``), or with the episode.
+  Always choosing f = 1 is the paper's trigger.
 
 A multi-channel id (``MultiBinary``: 004, the central cluster) shares one interval: a hold
 sends every channel, the paper's rule sends the channels it names. :class:`IntervalSchedule`
@@ -80,6 +80,9 @@ class DecisionSet:
             ``None`` for no shield.
         sampling_period_s: the env's sampling period (s), which the shield converts holds
             with; needed with ``shield_multiple``.
+        rule_cap: the longest "paper × f" interval in instants (an integer in 1..2^20), or
+            ``None`` for 2^k. A cap that is not a power of two lets a policy pair the rule with
+            a heartbeat of that period ("hold 1" once the cap passed without a transmission).
     """
 
     env_id: str
@@ -87,6 +90,7 @@ class DecisionSet:
     factors: tuple[float, ...] = DEFAULT_FACTORS
     shield_multiple: float | None = None
     sampling_period_s: float | None = None
+    rule_cap: int | None = None
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -98,6 +102,11 @@ class DecisionSet:
         if not all(np.isfinite(f) and f > 0.0 for f in factors):
             raise ValueError(f"factors must be finite numbers > 0, got {self.factors!r}")
         object.__setattr__(self, "factors", factors)
+        cap = self.rule_cap
+        if cap is not None and (
+            isinstance(cap, bool) or not isinstance(cap, int) or not 1 <= cap <= 2**20
+        ):
+            raise ValueError(f"rule_cap must be an integer in 1..{2**20} or None, got {cap!r}")
         if self.shield_multiple is None:
             return
         if self.env_id not in PAPER_SHIELDS:
@@ -112,6 +121,11 @@ class DecisionSet:
     def hold_steps(self) -> np.ndarray:
         """Sampling instants of each hold action: 1, 2, 4, ..., 2^k."""
         return 2 ** np.arange(self.max_exponent + 1)
+
+    @property
+    def rule_steps(self) -> int:
+        """The longest "paper × f" interval in instants: ``rule_cap``, else 2^k."""
+        return int(self.hold_steps[-1]) if self.rule_cap is None else self.rule_cap
 
     @property
     def n_holds(self) -> int:
@@ -256,7 +270,7 @@ class IntervalSchedule:
         fires = self._rule_fires(obs, state)
         if fires.ndim == 2:
             fires = fires.any(axis=1)
-        rule_over = (elapsed >= decisions.hold_steps[-1]) | ((elapsed >= 1) & fires)
+        rule_over = (elapsed >= decisions.rule_steps) | ((elapsed >= 1) & fires)
         return np.where(holding, elapsed >= hold_length, rule_over)
 
     def unconditional_holds(self, state: np.ndarray) -> np.ndarray:

@@ -157,6 +157,43 @@ def test_compiled_holds_equal_the_per_instant_path(env_id, shield):
         np.testing.assert_equal(list(got[1:]), list(expected[1:]))
 
 
+@pytest.mark.parametrize("rule_cap", [5, 24])
+def test_a_rule_cap_ends_follow_the_paper_intervals(rule_cap):
+    """With ``rule_cap`` a "follow the paper" interval lasts at most that many instants, in the
+    compiled path and instant by instant alike, and the deployed policy takes the same
+    transmit/hold actions."""
+    decisions = DecisionSet(ATTITUDE, max_exponent=3, factors=(64.0,), rule_cap=rule_cap)
+    assert decisions.rule_steps == rule_cap
+    follow = ScriptedModel(0, fixed=decisions.n_holds)
+    kwargs = {"max_exponent": 3, "factors": (64.0,), "rule_cap": rule_cap}
+    compiled = decision_episode(gym.make(ATTITUDE, horizon_s=HORIZON_S), follow, **kwargs)
+    actions, infos = wrapper_actions(ATTITUDE, follow, **kwargs)
+    elapsed = [info["elapsed_steps"] for info in infos[:-1]]
+    assert max(elapsed) == rule_cap
+    assert [result[4]["elapsed_steps"] for result in compiled[:-1]] == elapsed
+    assert_same(actions, policy_actions(ATTITUDE, deployed(ATTITUDE, follow, **kwargs)))
+
+
+def test_the_heartbeat_demonstrator_transmits_after_its_period():
+    """ "Paper x f" paired with a heartbeat of H instants: "hold 1" wherever H instants passed
+    without a transmission, so no gap between transmissions exceeds H + 1 instants."""
+    from agents.imitation import HeartbeatDecision
+
+    heartbeat = 12
+    kwargs = {"max_exponent": 3, "factors": (16.0,), "rule_cap": heartbeat}
+    wrapper = SelfTriggeredWrapper(gym.make(ATTITUDE, horizon_s=HORIZON_S), **kwargs)
+    names = wrapper.unwrapped.observation_names
+    demonstrator = HeartbeatDecision(
+        wrapper.decisions.n_holds, heartbeat, names, wrapper.decisions.sampling_period_s
+    )
+    actions, infos = wrapper_actions(ATTITUDE, demonstrator, **kwargs)
+    sent = np.flatnonzero(np.array(actions).reshape(-1))
+    assert {info["action"] for info in infos} == {0, wrapper.decisions.n_holds}
+    assert np.diff(sent).max() <= heartbeat + 1
+    with pytest.raises(ValueError, match="time_since_transmission_s"):
+        HeartbeatDecision(1, heartbeat, ("a", "b"), 0.001)
+
+
 def test_a_time_limit_sees_every_instant_of_a_hold():
     env = gym.make(ATTITUDE, horizon_s=HORIZON_S, max_episode_steps=50)
     assert interval_env(env) is None
@@ -225,6 +262,7 @@ def test_wrapper_passes_gymnasium_check_env():
     [
         ({"factors": (1.0, -2.0)}, "factors"),
         ({"max_exponent": -1}, "max_exponent"),
+        ({"rule_cap": 0}, "rule_cap"),
         ({"gamma": 0.0}, "gamma"),
     ],
 )
@@ -322,6 +360,16 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ({"decisions": {}, "imitation_steps": 64}, "imitation_steps"),
         ({"decisions": {}, "imitation_decision": "hold 1"}, "imitation_steps"),
         ({"imitation_decision": "hold 1"}, "'imitation_decision' needs the key 'decisions'"),
+        (
+            {
+                "decisions": {},
+                "imitation_steps": 8,
+                "imitation_decision": "hold 1",
+                "imitation_heartbeat": 0,
+            },
+            "'imitation_heartbeat' must be an integer >= 1",
+        ),
+        ({"imitation_heartbeat": 8}, "'imitation_heartbeat' needs the key 'imitation_decision'"),
         (
             {
                 "decisions": {"max_exponent": 3},
