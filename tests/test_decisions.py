@@ -433,3 +433,38 @@ def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
     evaluations = json.loads((out_dir / "evaluations.json").read_text(encoding="utf-8"))
     assert [entry["timesteps"] for entry in evaluations] == [0, 32, 64]  # 2 envs x 32 steps
     assert (out_dir / "best_model.zip").is_file()
+
+
+def test_cloning_the_rule_with_a_heartbeat_trains_and_deploys(tmp_path):
+    """A short run cloned from "paper x8 with a heartbeat" (``rule_cap`` and
+    ``imitation_heartbeat``) completes, records the demonstrator, and its saved model deploys
+    through ``sb3:`` with the cap in its decision set."""
+    import yaml
+
+    from agents.train import main
+
+    out_dir = tmp_path / "run"
+    config = {
+        "env_id": ATTITUDE,
+        "env_kwargs": {"horizon_s": 0.3},
+        "algorithm": "PPO",
+        "policy": "MlpPolicy",
+        "hyperparameters": {"n_steps": 32, "batch_size": 32, "n_epochs": 1, "gamma": 0.999},
+        "total_timesteps": 32,
+        "n_envs": 2,
+        "out_dir": str(out_dir),
+        "decisions": {"max_exponent": 3, "factors": [8.0], "rule_cap": 12},
+        "imitation_steps": 128,
+        "imitation_epochs": 30,
+        "imitation_decision": "paper x8",
+        "imitation_heartbeat": 12,
+        "tensorboard": False,
+    }
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    assert main(["--config", str(path)]) == 0
+    summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    assert summary["imitation"]["decision"] == "paper x8, heartbeat 12"
+    assert DecisionSet.load(out_dir / "model.zip").rule_cap == 12
+    result = evaluate(ATTITUDE, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
+    assert result["episodes"][0]["steps"] == 100
