@@ -16,6 +16,7 @@ from baselines.policies import load_sb3
 from baselines.self_triggered import decision_set_path, load_self_triggered
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.triggers import PAPER_TRIGGERS, AlwaysPolicy, PeriodicPolicy
+from etsc_envs.triggers.base import HeartbeatPolicy
 
 POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
@@ -157,7 +158,10 @@ def _policy_for(
         if env_id not in PAPER_TRIGGERS:
             raise ValueError(f"no paper trigger for {env_id}; known: {sorted(PAPER_TRIGGERS)}")
         names = observation_names()
-        return PAPER_TRIGGERS[env_id](observation_space, action_space, names, **policy_args)
+        arguments = dict(policy_args)
+        heartbeat = arguments.pop("heartbeat", None)
+        trigger = PAPER_TRIGGERS[env_id](observation_space, action_space, names, **arguments)
+        return trigger if heartbeat is None else HeartbeatPolicy(trigger, heartbeat)
     if spec.startswith("sb3:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")

@@ -4,11 +4,13 @@
         [--env-arg k=v ...] [--scenarios paper|validation|test [--set-size K]]
         [--episodes N] [--seed S] [--json PATH|-] [--plot DIR]
 
-POLICY is ``paper`` (the paper's triggering rule), ``periodic`` (``--policy-arg every=K``),
-``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3 model). ``--scenarios`` runs a
-fixed scenario set of the test protocol (docs/protocol.md); ``--episodes/--seed`` run ad-hoc
-draws instead. The JSON holds every episode's record, the means, and the aggregates with 95 %
-intervals (mean, median, IQM of mean_cost, transmissions and return; failure rate).
+POLICY is ``paper`` (the paper's triggering rule; ``--policy-arg heartbeat=H`` pairs it with a
+heartbeat, a transmission on every channel once H instants passed without one), ``periodic``
+(``--policy-arg every=K``), ``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3
+model). ``--scenarios`` runs a fixed scenario set of the test protocol (docs/protocol.md);
+``--episodes/--seed`` run ad-hoc draws instead. The JSON holds every episode's record, the
+means, and the aggregates with 95 % intervals (mean, median, IQM of mean_cost, transmissions
+and return; failure rate).
 """
 
 from __future__ import annotations

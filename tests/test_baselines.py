@@ -358,3 +358,44 @@ def test_sb3_model_round_trip(tmp_path, algorithm_name, kwargs):
     assert 0 <= episode["transmissions"] <= 50
     with pytest.raises(ValueError, match="policy-arg"):
         evaluate(ENV_ID, f"sb3:{path}", policy_args={"psi": 1}, env_args={"horizon_s": 0.05})
+
+
+@pytest.mark.parametrize(
+    ("env_id", "heartbeat"),
+    [("etsc/AttitudeTracking-v0", 10), ("etsc/InnerFormation-v0", 25)],
+)
+def test_a_heartbeat_bounds_every_channel_gap_and_keeps_the_rule(env_id, heartbeat):
+    """The paper's rule with a heartbeat transmits wherever the rule does, and no channel goes
+    more than ``heartbeat`` instants without a transmission; the batch path equals the
+    single-env path."""
+    args = {"horizon_s": 0.3}
+    thresholds = {"etsc/AttitudeTracking-v0": {"psi": 16.0}, "etsc/InnerFormation-v0": {}}
+    policy_args = {**thresholds[env_id], "heartbeat": heartbeat}
+    paired = evaluate(env_id, "paper", policy_args=policy_args, env_args=args, episodes=2)
+    alone = evaluate(env_id, "paper", policy_args=thresholds[env_id], env_args=args, episodes=2)
+    for with_beat, without in zip(paired["episodes"], alone["episodes"], strict=True):
+        assert with_beat["transmissions"] > without["transmissions"]
+    env = gym.make(env_id, **args)
+    unwrapped = env.unwrapped
+    rule = PAPER_TRIGGERS[env_id](
+        env.observation_space, env.action_space, unwrapped.observation_names, **thresholds[env_id]
+    )
+    from etsc_envs.triggers.base import HeartbeatPolicy
+
+    policy = HeartbeatPolicy(rule, heartbeat)
+    obs, _ = env.reset(seed=0)
+    state, sent_rows, done = None, [], False
+    while not done:
+        action, state = policy.predict(obs, state)
+        fires, _ = rule.transmit(obs[None], None)
+        assert np.all(np.asarray(action).reshape(-1) >= np.asarray(fires).reshape(-1))
+        sent_rows.append(np.asarray(action).reshape(-1))
+        obs, _, terminated, truncated, _ = env.step(action)
+        done = terminated or truncated
+    sent = np.array(sent_rows, dtype=bool)
+    for channel in range(sent.shape[1]):
+        instants = np.flatnonzero(sent[:, channel])
+        assert instants[0] <= heartbeat and np.diff(instants).max() <= heartbeat
+    assert paired["episodes"][0]["transmissions"] == sent.sum()
+    with pytest.raises(ValueError, match="heartbeat must be an integer >= 1"):
+        HeartbeatPolicy(rule, 0)

@@ -176,3 +176,46 @@ class PeriodicPolicy(TriggerPolicy):
         if self.n_bits is not None:
             decision = np.repeat(decision[:, None], self.n_bits, axis=1)
         return decision, counters + 1
+
+
+class HeartbeatPolicy(TriggerPolicy):
+    """A trigger paired with a heartbeat: ``trigger``'s decisions, and every channel at an
+    instant where ``heartbeat`` instants have passed since some channel last transmitted, so no
+    channel goes more than ``heartbeat`` instants without a transmission (an event trigger with
+    a clock as its backstop; the demonstrator of :class:`agents.imitation.HeartbeatDecision`
+    in self-triggered form).
+
+    The recurrent ``state`` holds ``trigger``'s state and, per row, the instants since the
+    stalest channel's last transmission; pass ``episode_start`` (or ``state=None`` at a reset)
+    to restart them. The episode starts as ``trigger`` decides: the first beat comes
+    ``heartbeat`` instants in, unless a transmission came before.
+    """
+
+    def __init__(self, trigger: TriggerPolicy, heartbeat: int) -> None:
+        super().__init__(trigger.observation_space, trigger.action_space)
+        if isinstance(heartbeat, bool) or int(heartbeat) != heartbeat or heartbeat < 1:
+            raise ValueError(
+                f"heartbeat must be an integer >= 1 (sampling instants), got {heartbeat!r}"
+            )
+        self.trigger = trigger
+        self.heartbeat = int(heartbeat)
+
+    def reset_state(self, state: Any, episode_start: np.ndarray, batch: int) -> Any:
+        if state is None:
+            return None
+        inner, silent = state
+        inner = self.trigger.reset_state(inner, episode_start, batch)
+        silent = np.array(silent)
+        silent[episode_start] = 0
+        return inner, silent
+
+    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
+        inner, silent = (None, None) if state is None else state
+        channels = 1 if self.n_bits is None else self.n_bits
+        if silent is None:
+            silent = np.zeros((len(obs), channels), dtype=np.int64)
+        decision, inner = self.trigger.transmit(obs, inner)
+        sent = np.array(decision, dtype=bool).reshape(len(obs), channels)
+        sent[silent.max(axis=1) >= self.heartbeat] = True
+        silent = np.where(sent, 1, silent + 1)
+        return (sent[:, 0] if self.n_bits is None else sent), (inner, silent)
