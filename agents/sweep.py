@@ -41,15 +41,16 @@ from urllib.parse import urlsplit
 import yaml
 
 from agents.sweep_config import SweepConfig, load_sweep_config
-from agents.sweep_processes import check_process_sweep, run_sweep_in_processes
+from agents.sweep_processes import run_sweep_in_processes
 from agents.sweep_results import (
-    SETTINGS_FILE,
     SweepTrial,
     final_scores,
+    one_line_error,
+    start_or_continue,
     trial_status,
     write_summary,
 )
-from etsc_envs.core.files import atomic_write_text, require_writable_folder
+from etsc_envs.core.files import require_writable_folder
 
 CONNECT_TIMEOUT_S = 5.0
 """How long the command waits for a Ray address to accept a connection."""
@@ -167,7 +168,7 @@ def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
     for result in results:
         name = Path(result.path).name
         folder = sweep.trial_folder(name)
-        error = None if result.error is None else _one_line(result.error)
+        error = None if result.error is None else one_line_error(result.error)
         values = result.config or _started_values(result.path) or grid_values.get(name, {})
         trials.append(
             SweepTrial(
@@ -197,14 +198,6 @@ def _started_values(tune_trial_dir: str) -> dict[str, Any]:
     return json.loads(params.read_text(encoding="utf-8")) if params.is_file() else {}
 
 
-def _one_line(error: BaseException) -> str:
-    """A trial's error as ``Type: first line of its message``, the underlying exception's when
-    Ray wraps it."""
-    cause = getattr(error, "cause", None) or error
-    lines = str(cause).strip().splitlines()
-    return f"{type(cause).__name__}: {lines[0]}" if lines else type(cause).__name__
-
-
 def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[SweepTrial]:
     """Run (or resume) the sweep on Ray, write its summary and return its trials."""
     import ray
@@ -214,7 +207,7 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
         raise ValueError(f"--resume: no saved sweep in {str(sweep.tune_dir)!r} to continue")
     if address is not None:
         check_reachable(address)
-    _start_or_continue(sweep, resume, sweep.tune_dir.exists() or sweep.trials_dir.exists())
+    start_or_continue(sweep, resume, sweep.tune_dir.exists() or sweep.trials_dir.exists())
     connect(address)
     try:
         results = build_tuner(sweep, resume).fit()
@@ -223,42 +216,6 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
     trials = summarize(sweep, results)
     write_summary(sweep.results_dir, _description(sweep), trials)
     return trials
-
-
-def _start_or_continue(sweep: SweepConfig, resume: bool, started: bool) -> None:
-    """Refuse to start over a sweep that has ``started`` (``--resume`` continues it, with the
-    settings it started with); record a new sweep's settings."""
-    if resume:
-        if not started:
-            raise ValueError(f"--resume: no sweep in {sweep.results_dir!r} to continue")
-        _check_unchanged(sweep)
-        return
-    if started:
-        raise ValueError(
-            f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
-            f"or choose another results_dir"
-        )
-    atomic_write_text(Path(sweep.results_dir) / SETTINGS_FILE, _settings_json(sweep))
-
-
-def _settings_json(sweep: SweepConfig) -> str:
-    return json.dumps(sweep.settings(), indent=2, sort_keys=True) + "\n"
-
-
-def _check_unchanged(sweep: SweepConfig) -> None:
-    """``ValueError`` if the sweep's settings differ from those it started with (Tune resumes
-    the trials it planned then; changed settings would mislabel them)."""
-    path = Path(sweep.results_dir) / SETTINGS_FILE
-    if not path.is_file():
-        return
-    started = json.loads(path.read_text(encoding="utf-8"))
-    now = json.loads(_settings_json(sweep))
-    changed = sorted(key for key in {*started, *now} if started.get(key) != now.get(key))
-    if changed:
-        raise ValueError(
-            f"--resume: the sweep's {changed} changed since it started (see {str(path)!r}); "
-            f"resume it with the settings it started with, or start another results_dir"
-        )
 
 
 def _description(sweep: SweepConfig) -> dict[str, Any]:
@@ -314,28 +271,22 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line: validate the config, run the sweep, report its trials."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.processes is not None:
-        if args.address is not None:
-            parser.error("--address joins a Ray cluster; --processes runs without Ray")
+    if args.processes is not None and args.address is not None:
+        parser.error("--address joins a Ray cluster; --processes runs without Ray")
+    if args.processes is None:
         try:
-            sweep = load_sweep_config(args.config)
-            require_writable_folder(sweep.results_dir, "results_dir")
-            check_process_sweep(sweep, args.processes)
-            _start_or_continue(sweep, args.resume, sweep.trials_dir.exists())
-            trials = run_sweep_in_processes(sweep, args.processes, _description(sweep))
-        except (OSError, ValueError, yaml.YAMLError) as error:
-            parser.error(str(error))
-        return _report(sweep, trials)
-    try:
-        import ray  # noqa: F401
-        from ray import tune  # noqa: F401
-    except ImportError:
-        parser.error('Ray Tune is not installed: pip install -e ".[train,sweep]"')
+            import ray  # noqa: F401
+            from ray import tune  # noqa: F401
+        except ImportError:
+            parser.error('Ray Tune is not installed: pip install -e ".[train,sweep]"')
     address = args.address or os.environ.get("RAY_ADDRESS") or None
     try:
         sweep = load_sweep_config(args.config)
         require_writable_folder(sweep.results_dir, "results_dir")
-        trials = run_sweep(sweep, address, args.resume)
+        if args.processes is None:
+            trials = run_sweep(sweep, address, args.resume)
+        else:
+            trials = run_sweep_in_processes(sweep, args.processes, args.resume, _description(sweep))
     except (OSError, ValueError, yaml.YAMLError) as error:
         parser.error(str(error))
     return _report(sweep, trials)

@@ -25,6 +25,8 @@ from agents.sweep_results import (
     EVALUATIONS_FILE,
     SweepTrial,
     final_scores,
+    one_line_error,
+    start_or_continue,
     training_finished,
     trial_status,
     write_summary,
@@ -54,17 +56,18 @@ def _run_trial(sweep: SweepConfig, values: dict[str, Any], folder: Path) -> str 
             (folder / EVALUATIONS_FILE).unlink(missing_ok=True)
         train(config, resume=resume)
     except Exception as error:  # a failed trial is recorded, the others go on
-        lines = str(error).strip().splitlines()
-        return f"{type(error).__name__}: {lines[0]}" if lines else type(error).__name__
+        return one_line_error(error)
     return None
 
 
 def run_sweep_in_processes(
-    sweep: SweepConfig, processes: int, description: dict[str, Any]
+    sweep: SweepConfig, processes: int, resume: bool, description: dict[str, Any]
 ) -> list[SweepTrial]:
-    """Run the grid's unfinished trials, ``processes`` at a time, write the summary (with
-    ``description``, the sweep's header) and return every trial in the grid's order."""
+    """Start the sweep (or continue it if ``resume``: :func:`start_or_continue`), run the
+    grid's unfinished trials, ``processes`` at a time, write the summary (with ``description``,
+    the sweep's header) and return every trial in the grid's order."""
     check_process_sweep(sweep, processes)
+    start_or_continue(sweep, resume, sweep.trials_dir.exists())
     points = {sweep.trial_name(values): values for values in sweep.grid_points()}
     pending = {
         name: values

@@ -4,6 +4,7 @@ shield, and a short training run that reloads through ``sb3:`` (short horizons).
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -395,37 +396,46 @@ def test_training_config_checks_the_decisions(tmp_path, changes, message):
         config_from_dict({**config, **changes})
 
 
-def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
-    """Behaviour cloning of one decision ("follow the paper at half its threshold") before
-    reinforcement: the cloned policy takes that decision on the demonstrations, and is
-    validated before reinforcement starts."""
+def train_cloned(tmp_path, **keys) -> tuple[Path, dict]:
+    """``agents.train`` on a short self-triggered config cloned before 32 steps of PPO (2 envs),
+    with ``keys`` replaced; the run's folder and its ``train_summary.json``."""
     import yaml
 
     from agents.train import main
 
     out_dir = tmp_path / "run"
     config = {
-        "env_id": FORMATION,
-        "env_kwargs": {"horizon_s": 0.2},
         "algorithm": "PPO",
         "policy": "MlpPolicy",
         "hyperparameters": {"n_steps": 32, "batch_size": 32, "n_epochs": 1, "gamma": 0.999},
         "total_timesteps": 32,
         "n_envs": 2,
         "out_dir": str(out_dir),
-        "decisions": {"max_exponent": 3},
-        "imitation_steps": 256,
-        "imitation_epochs": 60,
-        "imitation_decision": "paper x0.5",
-        "evaluation_every": 32,
-        "evaluation_scenarios": 2,
-        "evaluation_env_kwargs": {"horizon_s": 0.1},
         "tensorboard": False,
+        **keys,
     }
     path = tmp_path / "config.yaml"
     path.write_text(yaml.safe_dump(config), encoding="utf-8")
     assert main(["--config", str(path)]) == 0
-    summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    return out_dir, json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+
+
+def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
+    """Behaviour cloning of one decision ("follow the paper at half its threshold") before
+    reinforcement: the cloned policy takes that decision on the demonstrations, and is
+    validated before reinforcement starts."""
+    out_dir, summary = train_cloned(
+        tmp_path,
+        env_id=FORMATION,
+        env_kwargs={"horizon_s": 0.2},
+        decisions={"max_exponent": 3},
+        imitation_steps=256,
+        imitation_epochs=60,
+        imitation_decision="paper x0.5",
+        evaluation_every=32,
+        evaluation_scenarios=2,
+        evaluation_env_kwargs={"horizon_s": 0.1},
+    )
     imitation = summary["imitation"]
     assert imitation["decision"] == "paper x0.5" and imitation["steps"] == 256
     assert imitation["agreement"] >= 0.95  # chance: 1 in 8
@@ -439,31 +449,16 @@ def test_cloning_the_rule_with_a_heartbeat_trains_and_deploys(tmp_path):
     """A short run cloned from "paper x8 with a heartbeat" (``rule_cap`` and
     ``imitation_heartbeat``) completes, records the demonstrator, and its saved model deploys
     through ``sb3:`` with the cap in its decision set."""
-    import yaml
-
-    from agents.train import main
-
-    out_dir = tmp_path / "run"
-    config = {
-        "env_id": ATTITUDE,
-        "env_kwargs": {"horizon_s": 0.3},
-        "algorithm": "PPO",
-        "policy": "MlpPolicy",
-        "hyperparameters": {"n_steps": 32, "batch_size": 32, "n_epochs": 1, "gamma": 0.999},
-        "total_timesteps": 32,
-        "n_envs": 2,
-        "out_dir": str(out_dir),
-        "decisions": {"max_exponent": 3, "factors": [8.0], "rule_cap": 12},
-        "imitation_steps": 128,
-        "imitation_epochs": 30,
-        "imitation_decision": "paper x8",
-        "imitation_heartbeat": 12,
-        "tensorboard": False,
-    }
-    path = tmp_path / "config.yaml"
-    path.write_text(yaml.safe_dump(config), encoding="utf-8")
-    assert main(["--config", str(path)]) == 0
-    summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    out_dir, summary = train_cloned(
+        tmp_path,
+        env_id=ATTITUDE,
+        env_kwargs={"horizon_s": 0.3},
+        decisions={"max_exponent": 3, "factors": [8.0], "rule_cap": 12},
+        imitation_steps=128,
+        imitation_epochs=30,
+        imitation_decision="paper x8",
+        imitation_heartbeat=12,
+    )
     assert summary["imitation"]["decision"] == "paper x8, heartbeat 12"
     assert DecisionSet.load(out_dir / "model.zip").rule_cap == 12
     result = evaluate(ATTITUDE, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})

@@ -22,9 +22,9 @@ pytest.importorskip("stable_baselines3")
 pytest.importorskip("ray.tune")
 
 from agents.sweep import main
+from tests.sweep_fixtures import tiny_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
-TINY = ROOT / "configs" / "sweeps" / "tiny.yaml"
 FIRST, SECOND, CRASHING = (
     "transmission_penalty=30",
     "transmission_penalty=100",
@@ -32,17 +32,6 @@ FIRST, SECOND, CRASHING = (
 )
 START_TIMEOUT_S = 600.0
 """Longest wait for the first trial's model (Ray's start and the imports on a busy machine)."""
-
-
-def tiny_sweep(tmp_path: Path, **keys: Any) -> Path:
-    """``configs/sweeps/tiny.yaml`` with its results in ``tmp_path`` and ``keys`` replaced."""
-    raw = yaml.safe_load(TINY.read_text(encoding="utf-8"))
-    raw["base"] = str(ROOT / raw["base"])
-    raw["results_dir"] = str(tmp_path / "sweep")
-    raw.update(keys)
-    path = tmp_path / "sweep.yaml"
-    path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
-    return path
 
 
 def sweep_command(config: Path, *options: str) -> list[str]:

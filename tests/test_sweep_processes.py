@@ -11,25 +11,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
+
+from tests.sweep_fixtures import tiny_sweep
 
 pytest.importorskip("stable_baselines3")
 
 ROOT = Path(__file__).resolve().parents[1]
-TINY = ROOT / "configs" / "sweeps" / "tiny.yaml"
 FINISHING = ("transmission_penalty=30", "transmission_penalty=100")
 CRASHING = "transmission_penalty=-1"
-
-
-def tiny_sweep(tmp_path: Path, **keys: Any) -> Path:
-    """``configs/sweeps/tiny.yaml`` with its results in ``tmp_path`` and ``keys`` replaced."""
-    raw = yaml.safe_load(TINY.read_text(encoding="utf-8"))
-    raw["base"] = str(ROOT / raw["base"])
-    raw["results_dir"] = str(tmp_path / "sweep")
-    raw.update(keys)
-    path = tmp_path / "sweep.yaml"
-    path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
-    return path
 
 
 def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:

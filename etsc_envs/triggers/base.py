@@ -182,11 +182,10 @@ class HeartbeatPolicy(TriggerPolicy):
     """A trigger paired with a heartbeat: ``trigger``'s decisions, and every channel at an
     instant where ``heartbeat`` instants have passed since some channel last transmitted, so no
     channel goes more than ``heartbeat`` instants without a transmission (an event trigger with
-    a clock as its backstop; the demonstrator of :class:`agents.imitation.HeartbeatDecision`
-    in self-triggered form).
+    a clock as its backstop; the checkout's self-triggered training clones the same pairing).
 
-    The recurrent ``state`` holds ``trigger``'s state and, per row, the instants since the
-    stalest channel's last transmission; pass ``episode_start`` (or ``state=None`` at a reset)
+    The recurrent ``state`` holds ``trigger``'s state and, per row and channel, the instants
+    since that channel's last transmission; pass ``episode_start`` (or ``state=None`` at a reset)
     to restart them. The episode starts as ``trigger`` decides: the first beat comes
     ``heartbeat`` instants in, unless a transmission came before.
     """
