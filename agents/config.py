@@ -56,6 +56,10 @@ A config is a YAML mapping with these keys (the optional ones show their default
   transmission lies H or more instants back, else ``imitation_decision`` — the paper's rule
   paired with a heartbeat of period H when ``decisions.rule_cap`` is H
   (:class:`agents.imitation.HeartbeatDecision`);
+* ``imitation_pinned_probability: null`` — with ``imitation_decision`` and no heartbeat, a
+  probability p in (0, 1): after cloning, the policy's action head is set to take the cloned
+  decision with probability p at every observation (:func:`agents.imitation.pin_decision`),
+  so that training starts from the fixed decision exactly rather than from a fit of it;
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
   ``shield_multiple``; its ``gamma`` is ``hyperparameters.gamma``), on a ``DummyVecEnv`` of
@@ -124,6 +128,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "imitation_epochs": 10,
     "imitation_decision": None,
     "imitation_heartbeat": None,
+    "imitation_pinned_probability": None,
     "decisions": None,
 }
 
@@ -158,6 +163,7 @@ class TrainConfig:
     imitation_epochs: int
     imitation_decision: str | None
     imitation_heartbeat: int | None
+    imitation_pinned_probability: float | None
     decisions: dict[str, Any] | None
 
     @property
@@ -227,6 +233,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
         imitation_decision=values["imitation_decision"],
         imitation_heartbeat=_check_heartbeat(values),
+        imitation_pinned_probability=_check_pinned_probability(values),
         decisions=decisions,
     )
 
@@ -279,6 +286,33 @@ def _check_heartbeat(values: Mapping[str, Any]) -> int | None:
     if values["imitation_decision"] is None:
         raise ValueError("config key 'imitation_heartbeat' needs the key 'imitation_decision'")
     return heartbeat
+
+
+def _check_pinned_probability(values: Mapping[str, Any]) -> float | None:
+    """``values["imitation_pinned_probability"]``: null, or p in (0, 1) beside an imitation
+    decision without a heartbeat."""
+    probability = values["imitation_pinned_probability"]
+    if probability is None:
+        return None
+    if (
+        isinstance(probability, bool)
+        or not isinstance(probability, int | float)
+        or not 0.0 < probability < 1.0
+    ):
+        raise ValueError(
+            "config key 'imitation_pinned_probability' must be a number in (0, 1) or null, "
+            f"got {probability!r}"
+        )
+    if values["imitation_decision"] is None:
+        raise ValueError(
+            "config key 'imitation_pinned_probability' needs the key 'imitation_decision'"
+        )
+    if values["imitation_heartbeat"] is not None:
+        raise ValueError(
+            "config keys 'imitation_pinned_probability' and 'imitation_heartbeat' exclude each "
+            "other: a pinned policy takes one fixed decision at every observation"
+        )
+    return float(probability)
 
 
 def _check_decisions(

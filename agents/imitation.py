@@ -17,11 +17,16 @@ head to predict the discounted returns of the collected episodes.
 (:class:`agents.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
 the set (the better of the paper's rule at some threshold and the best clock, chosen on the
 validation set), or that decision paired with a heartbeat (:class:`HeartbeatDecision`), and
-returns are discounted by the instants each decision lasted.
+returns are discounted by the instants each decision lasted. A fitted clone of one fixed
+decision agrees with it on the states the demonstrations visited only: elsewhere (later times,
+larger errors) the network's output may leave it, and on papers 000 and 001 it did.
+:func:`pin_decision` then makes the decision exact — the policy's mode at every observation —
+so that the learner starts from the baseline itself and not from an approximation of it.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -213,6 +218,27 @@ class HeartbeatDecision:
         return np.where(silent_s >= self.threshold_s, 0, self.action).astype(np.int64), state
 
 
+def pin_decision(model: BaseAlgorithm, action: int, probability: float) -> float:
+    """Set the action head of ``model`` (a categorical policy's last linear layer) so that the
+    policy takes ``action`` with ``probability`` at every observation and shares ``1 -
+    probability`` evenly among its other actions: weights zero, and a bias of ``log(p (n - 1) /
+    (1 - p))`` on ``action`` over ``n`` actions. Its deterministic policy is then ``action``
+    exactly; the zero weights still receive gradients, so PPO can make it depend on the state.
+    Returns the bias margin."""
+    if not 0.0 < probability < 1.0:
+        raise ValueError(f"probability must be in (0, 1), got {probability!r}")
+    head = model.policy.action_net
+    count = head.out_features
+    if not 0 <= action < count:
+        raise ValueError(f"action must be in 0..{count - 1}, got {action!r}")
+    margin = math.log(probability * (count - 1) / (1.0 - probability)) if count > 1 else 0.0
+    with torch.no_grad():
+        head.weight.zero_()
+        head.bias.zero_()
+        head.bias[action] = margin
+    return margin
+
+
 def imitate_decision(
     model: BaseAlgorithm,
     decisions: DecisionSet,
@@ -220,11 +246,15 @@ def imitate_decision(
     steps: int,
     epochs: int,
     heartbeat: int | None = None,
+    pinned_probability: float | None = None,
 ) -> dict[str, Any]:
     """Clone the decision ``label`` of ``decisions`` (``"paper x0.25"``, ``"hold 64"``) into
     ``model``, a learner of self-triggered decisions, from ``steps`` decisions on its own
     training env, paired with a ``heartbeat`` of that many instants if given
-    (:class:`HeartbeatDecision`); returns the fit's summary."""
+    (:class:`HeartbeatDecision`); with ``pinned_probability`` (and no heartbeat), the action
+    head is then pinned to the decision (:func:`pin_decision`; the fit still sets the value
+    head and the observation statistics). Returns the fit's summary, its ``agreement`` the
+    pinned policy's where pinned."""
     action = decisions.action(label)
     env = model.get_env()
     gamma = float(getattr(model, "gamma", 0.99))
@@ -238,4 +268,12 @@ def imitate_decision(
     batch_size = int(getattr(model, "batch_size", 256))
     summary = clone(model, observations, actions, returns, epochs, batch_size, separate_heads=True)
     described = label if heartbeat is None else f"{label}, heartbeat {heartbeat}"
+    if pinned_probability is not None:
+        if heartbeat is not None:
+            raise ValueError("pinned_probability pins one fixed decision: give no heartbeat")
+        pin_decision(model, action, pinned_probability)
+        predicted, _ = model.policy.predict(observations, deterministic=True)
+        summary["clone_agreement"] = summary["agreement"]
+        summary["agreement"] = float(np.mean(predicted.reshape(actions.shape) == actions))
+        described = f"{label}, pinned at probability {pinned_probability:g}"
     return {"steps": len(observations), "decision": described, **summary}

@@ -174,6 +174,7 @@ def _train(
                 config.imitation_steps,
                 config.imitation_epochs,
                 heartbeat=config.imitation_heartbeat,
+                pinned_probability=config.imitation_pinned_probability,
             )
         elif config.imitation_steps:
             imitation = imitate_paper_trigger(

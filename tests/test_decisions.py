@@ -372,6 +372,29 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ),
         ({"imitation_heartbeat": 8}, "'imitation_heartbeat' needs the key 'imitation_decision'"),
         (
+            {"imitation_pinned_probability": 0.9},
+            "'imitation_pinned_probability' needs the key 'imitation_decision'",
+        ),
+        (
+            {
+                "decisions": {},
+                "imitation_steps": 8,
+                "imitation_decision": "hold 1",
+                "imitation_pinned_probability": 1.0,
+            },
+            r"'imitation_pinned_probability' must be a number in \(0, 1\)",
+        ),
+        (
+            {
+                "decisions": {},
+                "imitation_steps": 8,
+                "imitation_decision": "hold 1",
+                "imitation_heartbeat": 8,
+                "imitation_pinned_probability": 0.9,
+            },
+            "'imitation_pinned_probability' and 'imitation_heartbeat' exclude each other",
+        ),
+        (
             {
                 "decisions": {"max_exponent": 3},
                 "imitation_steps": 8,
@@ -463,3 +486,66 @@ def test_cloning_the_rule_with_a_heartbeat_trains_and_deploys(tmp_path):
     assert DecisionSet.load(out_dir / "model.zip").rule_cap == 12
     result = evaluate(ATTITUDE, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
     assert result["episodes"][0]["steps"] == 100
+
+
+def test_a_pinned_decision_is_the_policy_everywhere(tmp_path):
+    """A pinned clone takes its decision at every observation, also far outside the states the
+    demonstrations visited, and samples it with the pinned probability; PPO's first update
+    then moves the policy from that exact start."""
+    import torch
+    from stable_baselines3 import PPO
+
+    from agents.imitation import pin_decision
+
+    env = SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.1), max_exponent=3)
+    model = PPO("MlpPolicy", env, n_steps=32, batch_size=32, n_epochs=1, seed=0)
+    action = env.decisions.action("hold 4")
+    margin = pin_decision(model, action, 0.9)
+    others = env.action_space.n - 1
+    assert margin == pytest.approx(np.log(0.9 * others / 0.1))
+    far = np.random.default_rng(0).normal(scale=1e3, size=(256, *env.observation_space.shape))
+    predicted, _ = model.predict(far.astype(np.float32), deterministic=True)
+    assert np.all(predicted == action)
+    with torch.no_grad():
+        distribution = model.policy.get_distribution(model.policy.obs_to_tensor(far)[0])
+    probabilities = distribution.distribution.probs.numpy()
+    np.testing.assert_allclose(probabilities[:, action], 0.9, rtol=1e-5)
+    np.testing.assert_allclose(np.delete(probabilities, action, axis=1), 0.1 / others, rtol=1e-4)
+    model.learn(32)
+    assert np.abs(model.policy.action_net.weight.detach().numpy()).max() > 0.0
+    with pytest.raises(ValueError, match=r"probability must be in \(0, 1\)"):
+        pin_decision(model, action, 1.0)
+
+
+def test_agents_train_pins_the_cloned_decision(tmp_path):
+    """``imitation_pinned_probability``: the clone's summary records the pin and agrees with the
+    decision on every demonstration, and the model validated first is that decision."""
+    out_dir, summary = train_cloned(
+        tmp_path,
+        env_id=FORMATION,
+        env_kwargs={"horizon_s": 0.2},
+        decisions={"max_exponent": 3},
+        imitation_steps=64,
+        imitation_epochs=2,
+        imitation_decision="hold 8",
+        imitation_pinned_probability=0.9,
+        evaluation_every=32,
+        evaluation_scenarios=2,
+        evaluation_env_kwargs={"horizon_s": 0.1},
+    )
+    imitation = summary["imitation"]
+    assert imitation["decision"] == "hold 8, pinned at probability 0.9"
+    assert imitation["agreement"] == 1.0 and 0.0 <= imitation["clone_agreement"] <= 1.0
+    evaluations = json.loads((out_dir / "evaluations.json").read_text(encoding="utf-8"))
+    clock = evaluate(
+        FORMATION,
+        "periodic",
+        policy_args={"every": 8},
+        env_args={"horizon_s": 0.1},
+        scenarios="validation",
+        set_size=2,
+    )["mean"]
+    first = evaluations[0]
+    assert first["timesteps"] == 0
+    assert first["learned"]["transmissions"] == clock["transmissions"]
+    assert first["learned"]["mean_cost"] == pytest.approx(clock["mean_cost"], rel=1e-12)
