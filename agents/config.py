@@ -51,18 +51,14 @@ A config is a YAML mapping with these keys (the optional ones show their default
   (``"paper x0.25"``, ``"hold 64"``: :meth:`baselines.self_triggered.DecisionSet.label`;
   :func:`agents.imitation.imitate_decision`); needed with ``decisions`` and
   ``imitation_steps``, refused without ``decisions``;
-* ``imitation_heartbeat: null`` — with ``imitation_decision``, a number of instants H: the
-  demonstrator then chooses "hold 1" (transmit now) at a decision where the last
-  transmission lies H or more instants back, else ``imitation_decision`` — the paper's rule
-  paired with a heartbeat of period H when ``decisions.rule_cap`` is H
-  (:class:`agents.imitation.HeartbeatDecision`);
-* ``imitation_pinned_probability: null`` — with ``imitation_decision`` and no heartbeat, a
-  probability p in (0, 1): after cloning, the policy's action head is set to take the cloned
-  decision with probability p at every observation (:func:`agents.imitation.pin_decision`),
-  so that training starts from the fixed decision exactly rather than from a fit of it;
+* ``imitation_pinned_probability: null`` — with ``imitation_decision``, a probability p in
+  (0, 1): after cloning, the policy's action head is set to take the cloned decision with
+  probability p at every observation (:func:`agents.imitation.pin_decision`), so that
+  training starts from the fixed decision exactly rather than from a fit of it;
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
-  ``shield_multiple``; its ``gamma`` is ``hyperparameters.gamma``), on a ``DummyVecEnv`` of
+  ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``; its ``gamma`` is
+  ``hyperparameters.gamma``), on a ``DummyVecEnv`` of
   wrapped envs (Gymnasium ids only; cloning with ``imitation_decision``). PPO, A2C and MaskablePPO
   then discount by elapsed instants (:mod:`agents.elapsed_discount`); the models are saved with
   their decision set beside them, so that ``sb3:`` deploys them as transmit/hold policies;
@@ -127,7 +123,6 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "imitation_steps": 0,
     "imitation_epochs": 10,
     "imitation_decision": None,
-    "imitation_heartbeat": None,
     "imitation_pinned_probability": None,
     "decisions": None,
 }
@@ -162,7 +157,6 @@ class TrainConfig:
     imitation_steps: int
     imitation_epochs: int
     imitation_decision: str | None
-    imitation_heartbeat: int | None
     imitation_pinned_probability: float | None
     decisions: dict[str, Any] | None
 
@@ -232,7 +226,6 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
         imitation_decision=values["imitation_decision"],
-        imitation_heartbeat=_check_heartbeat(values),
         imitation_pinned_probability=_check_pinned_probability(values),
         decisions=decisions,
     )
@@ -274,23 +267,9 @@ def _check_algorithm(name: Any) -> str:
     return name
 
 
-def _check_heartbeat(values: Mapping[str, Any]) -> int | None:
-    """``values["imitation_heartbeat"]``: null, or instants >= 1 beside an imitation decision."""
-    heartbeat = values["imitation_heartbeat"]
-    if heartbeat is None:
-        return None
-    if isinstance(heartbeat, bool) or not isinstance(heartbeat, int) or heartbeat < 1:
-        raise ValueError(
-            f"config key 'imitation_heartbeat' must be an integer >= 1 or null, got {heartbeat!r}"
-        )
-    if values["imitation_decision"] is None:
-        raise ValueError("config key 'imitation_heartbeat' needs the key 'imitation_decision'")
-    return heartbeat
-
-
 def _check_pinned_probability(values: Mapping[str, Any]) -> float | None:
     """``values["imitation_pinned_probability"]``: null, or p in (0, 1) beside an imitation
-    decision without a heartbeat."""
+    decision."""
     probability = values["imitation_pinned_probability"]
     if probability is None:
         return None
@@ -306,11 +285,6 @@ def _check_pinned_probability(values: Mapping[str, Any]) -> float | None:
     if values["imitation_decision"] is None:
         raise ValueError(
             "config key 'imitation_pinned_probability' needs the key 'imitation_decision'"
-        )
-    if values["imitation_heartbeat"] is not None:
-        raise ValueError(
-            "config keys 'imitation_pinned_probability' and 'imitation_heartbeat' exclude each "
-            "other: a pinned policy takes one fixed decision at every observation"
         )
     return float(probability)
 
@@ -336,7 +310,7 @@ def _check_decisions(
             "'decisions' (the decision to clone, and for how many decisions), got "
             f"imitation_steps={values['imitation_steps']!r}, imitation_decision={label!r}"
         )
-    allowed = ("max_exponent", "factors", "shield_multiple", "rule_cap")
+    allowed = ("max_exponent", "factors", "shield_multiple", "rule_cap", "rule_heartbeat")
     unknown = sorted(set(decisions) - set(allowed))
     if unknown:
         raise ValueError(f"config key 'decisions': {unknown} are not among {list(allowed)}")

@@ -68,6 +68,8 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         gamma: the per-instant discount within an interval (in (0, 1]); the algorithm's
             ``gamma`` when it discounts by elapsed instants.
         rule_cap: the longest "paper × f" interval in instants (``None``: 2^max_exponent).
+        rule_heartbeat: whether "paper × f" intervals transmit at their decision instant
+            (the rule paired with a heartbeat of ``rule_cap`` instants).
     """
 
     def __init__(
@@ -78,6 +80,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         shield_multiple: float | None = None,
         gamma: float = 0.99,
         rule_cap: int | None = None,
+        rule_heartbeat: bool = False,
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -86,6 +89,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             shield_multiple=shield_multiple,
             gamma=gamma,
             rule_cap=rule_cap,
+            rule_heartbeat=rule_heartbeat,
         )
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
@@ -99,6 +103,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             shield_multiple=shield_multiple,
             sampling_period_s=float(unwrapped.params.sampling_period_s),
             rule_cap=rule_cap,
+            rule_heartbeat=rule_heartbeat,
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names
@@ -135,7 +140,10 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         following = int(chosen[0]) - self.decisions.n_holds
         if following >= 0 and self._loop is not None:
             observation, total, terminated, truncated, info, steps = self._loop.run_rule_interval(
-                self.schedule.triggers[following], self.decisions.rule_steps, self.gamma
+                self.schedule.triggers[following],
+                self.decisions.rule_steps,
+                self.gamma,
+                send_first=self.decisions.rule_heartbeat,
             )
         else:
             observation, total, terminated, truncated, info, steps = self._run_schedule(chosen)

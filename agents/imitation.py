@@ -16,10 +16,10 @@ head to predict the discounted returns of the collected episodes.
 :func:`imitate_decision` does the same for self-triggered decisions
 (:class:`agents.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
 the set (the better of the paper's rule at some threshold and the best clock, chosen on the
-validation set), or that decision paired with a heartbeat (:class:`HeartbeatDecision`), and
-returns are discounted by the instants each decision lasted. A fitted clone of one fixed
-decision agrees with it on the states the demonstrations visited only: elsewhere (later times,
-larger errors) the network's output may leave it, and on papers 000 and 001 it did.
+validation set), and returns are discounted by the instants each decision lasted. A fitted
+clone of one fixed decision agrees with it on the states the demonstrations visited only:
+elsewhere (later times, larger errors) the network's output may leave it, and on papers 000
+and 001 it did.
 :func:`pin_decision` then makes the decision exact — the policy's mode at every observation —
 so that the learner starts from the baseline itself and not from an approximation of it.
 """
@@ -179,45 +179,6 @@ class FixedDecision:
         return np.full(len(observation), self.action, dtype=np.int64), state
 
 
-class HeartbeatDecision:
-    """A demonstrator of :func:`imitate_decision`: ``action``, except "hold 1" (action 0:
-    transmit now, decide again at the next instant) where the last transmission lies
-    ``heartbeat`` instants or more back (on the stalest channel, read from the observations'
-    ``time_since_transmission_s`` entries). With the decision set's ``rule_cap`` equal to
-    ``heartbeat`` and ``action`` a "paper × f", this is the rule paired with a heartbeat: a
-    transmission when the rule fires or when ``heartbeat`` instants passed without one."""
-
-    def __init__(
-        self,
-        action: int,
-        heartbeat: int,
-        observation_names: tuple[str, ...],
-        sampling_period_s: float,
-    ) -> None:
-        self.action = int(action)
-        self.columns = [
-            index
-            for index, name in enumerate(observation_names)
-            if name.startswith("time_since_transmission_s")
-        ]
-        if not self.columns:
-            raise ValueError(
-                "imitation_heartbeat: the observations hold no time_since_transmission_s"
-            )
-        # half an instant below H periods, so that rounding of the clock cannot miss it
-        self.threshold_s = (heartbeat - 0.5) * sampling_period_s
-
-    def predict(
-        self,
-        observation: np.ndarray,
-        state: Any = None,
-        episode_start: np.ndarray | None = None,
-        deterministic: bool = True,
-    ) -> tuple[np.ndarray, Any]:
-        silent_s = np.asarray(observation)[:, self.columns].max(axis=1)
-        return np.where(silent_s >= self.threshold_s, 0, self.action).astype(np.int64), state
-
-
 def pin_decision(model: BaseAlgorithm, action: int, probability: float) -> float:
     """Set the action head of ``model`` (a categorical policy's last linear layer) so that the
     policy takes ``action`` with ``probability`` at every observation and shares ``1 -
@@ -245,32 +206,24 @@ def imitate_decision(
     label: str,
     steps: int,
     epochs: int,
-    heartbeat: int | None = None,
     pinned_probability: float | None = None,
 ) -> dict[str, Any]:
     """Clone the decision ``label`` of ``decisions`` (``"paper x0.25"``, ``"hold 64"``) into
     ``model``, a learner of self-triggered decisions, from ``steps`` decisions on its own
-    training env, paired with a ``heartbeat`` of that many instants if given
-    (:class:`HeartbeatDecision`); with ``pinned_probability`` (and no heartbeat), the action
-    head is then pinned to the decision (:func:`pin_decision`; the fit still sets the value
-    head and the observation statistics). Returns the fit's summary, its ``agreement`` the
+    training env; with ``pinned_probability``, the action head is then pinned to the decision
+    (:func:`pin_decision`; the fit still sets the value head and the observation statistics).
+    Returns the fit's summary, its ``agreement`` the
     pinned policy's where pinned."""
     action = decisions.action(label)
     env = model.get_env()
     gamma = float(getattr(model, "gamma", 0.99))
-    demonstrator: Any = FixedDecision(action)
-    if heartbeat is not None:
-        names = tuple(env.get_attr("observation_names", [0])[0])
-        demonstrator = HeartbeatDecision(
-            action, heartbeat, names, float(decisions.sampling_period_s)
-        )
-    observations, actions, returns = collect_demonstrations(env, demonstrator, steps, gamma)
+    observations, actions, returns = collect_demonstrations(
+        env, FixedDecision(action), steps, gamma
+    )
     batch_size = int(getattr(model, "batch_size", 256))
     summary = clone(model, observations, actions, returns, epochs, batch_size, separate_heads=True)
-    described = label if heartbeat is None else f"{label}, heartbeat {heartbeat}"
+    described = label
     if pinned_probability is not None:
-        if heartbeat is not None:
-            raise ValueError("pinned_probability pins one fixed decision: give no heartbeat")
         pin_decision(model, action, pinned_probability)
         predicted, _ = model.policy.predict(observations, deterministic=True)
         summary["clone_agreement"] = summary["agreement"]

@@ -173,7 +173,6 @@ def _train(
                 str(config.imitation_decision),
                 config.imitation_steps,
                 config.imitation_epochs,
-                heartbeat=config.imitation_heartbeat,
                 pinned_probability=config.imitation_pinned_probability,
             )
         elif config.imitation_steps:

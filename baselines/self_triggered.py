@@ -10,6 +10,11 @@ An action of :class:`DecisionSet` is one of
   decision instant included; the interval ends just before a later instant at which it fires
   (on any channel), after 2^k instants (or the set's ``rule_cap``), or with the episode.
   Always choosing f = 1 is the paper's trigger.
+* **paper × f, heartbeat H** (a set with ``rule_heartbeat``, H its ``rule_cap``): as paper × f,
+  but every channel transmits at the decision instant. The interval ends just before the rule
+  fires or H instants after that transmission, so always choosing it is the rule paired with a
+  heartbeat of H instants (:class:`~etsc_envs.triggers.base.HeartbeatPolicy`; on a
+  multi-channel id, an instant at which the rule fires on some channel sends every channel).
 
 A multi-channel id (``MultiBinary``: 004, the central cluster) shares one interval: a hold
 sends every channel, the paper's rule sends the channels it names. :class:`IntervalSchedule`
@@ -81,8 +86,10 @@ class DecisionSet:
         sampling_period_s: the env's sampling period (s), which the shield converts holds
             with; needed with ``shield_multiple``.
         rule_cap: the longest "paper × f" interval in instants (an integer in 1..2^20), or
-            ``None`` for 2^k. A cap that is not a power of two lets a policy pair the rule with
-            a heartbeat of that period ("hold 1" once the cap passed without a transmission).
+            ``None`` for 2^k.
+        rule_heartbeat: whether a "paper × f" interval transmits every channel at its decision
+            instant, making it "paper × f, heartbeat ``rule_cap``" (see the module's
+            description).
     """
 
     env_id: str
@@ -91,6 +98,7 @@ class DecisionSet:
     shield_multiple: float | None = None
     sampling_period_s: float | None = None
     rule_cap: int | None = None
+    rule_heartbeat: bool = False
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -107,6 +115,8 @@ class DecisionSet:
             isinstance(cap, bool) or not isinstance(cap, int) or not 1 <= cap <= 2**20
         ):
             raise ValueError(f"rule_cap must be an integer in 1..{2**20} or None, got {cap!r}")
+        if not isinstance(self.rule_heartbeat, bool):
+            raise ValueError(f"rule_heartbeat must be true or false, got {self.rule_heartbeat!r}")
         if self.shield_multiple is None:
             return
         if self.env_id not in PAPER_SHIELDS:
@@ -137,10 +147,11 @@ class DecisionSet:
         return gym.spaces.Discrete(self.n_holds + len(self.factors))
 
     def label(self, action: int) -> str:
-        """``action`` in words (``hold 8``, ``paper x2``)."""
+        """``action`` in words (``hold 8``, ``paper x2``, ``paper x2, heartbeat 384``)."""
         if action < self.n_holds:
             return f"hold {int(self.hold_steps[action])}"
-        return f"paper x{self.factors[action - self.n_holds]:g}"
+        label = f"paper x{self.factors[action - self.n_holds]:g}"
+        return f"{label}, heartbeat {self.rule_steps}" if self.rule_heartbeat else label
 
     def action(self, label: str) -> int:
         """The action :meth:`label` names ``label``; ``ValueError`` listing the labels if none."""
@@ -284,7 +295,8 @@ class IntervalSchedule:
     def transmit(self, obs: np.ndarray, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Each row's transmit decision at the instant of ``obs`` (booleans, one column per
         channel for ``MultiBinary``) and the state after it."""
-        first = (state[:, 0] < self.decisions.n_holds) & (state[:, 1] == 0)
+        sends_first = (state[:, 0] < self.decisions.n_holds) | self.decisions.rule_heartbeat
+        first = sends_first & (state[:, 1] == 0)
         decision = self._rule_fires(obs, state)
         decision[first] = True
         return decision, state + np.array([0, 1])

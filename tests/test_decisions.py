@@ -18,7 +18,7 @@ from baselines.episodes import run_episode
 from baselines.evaluate import evaluate
 from baselines.policies import load_sb3, takes_action_masks
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
-from etsc_envs.triggers import PAPER_TRIGGERS, PeriodicPolicy
+from etsc_envs.triggers import PAPER_THRESHOLDS, PAPER_TRIGGERS, PeriodicPolicy
 from etsc_envs.triggers.asteroid import AsteroidShield
 from etsc_envs.triggers.inner_formation import InnerFormationShield
 
@@ -175,24 +175,38 @@ def test_a_rule_cap_ends_follow_the_paper_intervals(rule_cap):
     assert_same(actions, policy_actions(ATTITUDE, deployed(ATTITUDE, follow, **kwargs)))
 
 
-def test_the_heartbeat_demonstrator_transmits_after_its_period():
-    """ "Paper x f" paired with a heartbeat of H instants: "hold 1" wherever H instants passed
-    without a transmission, so no gap between transmissions exceeds H + 1 instants."""
-    from agents.imitation import HeartbeatDecision
+@pytest.mark.parametrize(
+    ("env_id", "factor", "heartbeat"), [(ATTITUDE, 16.0, 12), (ATTITUDE, 2.0, 40)]
+)
+def test_the_heartbeat_action_is_the_rule_paired_with_a_heartbeat(env_id, factor, heartbeat):
+    """Always choosing "paper x f, heartbeat H" (``rule_heartbeat``) takes the transmit/hold
+    actions of :class:`HeartbeatPolicy` over the rule at f, in the compiled path, instant by
+    instant and deployed alike; no gap between transmissions exceeds H instants."""
+    from etsc_envs.triggers.base import HeartbeatPolicy
 
-    heartbeat = 12
-    kwargs = {"max_exponent": 3, "factors": (16.0,), "rule_cap": heartbeat}
-    wrapper = SelfTriggeredWrapper(gym.make(ATTITUDE, horizon_s=HORIZON_S), **kwargs)
-    names = wrapper.unwrapped.observation_names
-    demonstrator = HeartbeatDecision(
-        wrapper.decisions.n_holds, heartbeat, names, wrapper.decisions.sampling_period_s
+    kwargs = {"max_exponent": 3, "factors": (factor,), "rule_cap": heartbeat}
+    decisions = DecisionSet(env_id, **kwargs, rule_heartbeat=True)
+    assert decisions.label(decisions.n_holds) == f"paper x{factor:g}, heartbeat {heartbeat}"
+    follow = ScriptedModel(0, fixed=decisions.n_holds)
+    kwargs["rule_heartbeat"] = True
+    actions, infos = wrapper_actions(env_id, follow, **kwargs)
+    compiled = decision_episode(gym.make(env_id, horizon_s=HORIZON_S), follow, **kwargs)
+    assert [result[4]["elapsed_steps"] for result in compiled] == [
+        info["elapsed_steps"] for info in infos
+    ]
+    env = gym.make(env_id, horizon_s=HORIZON_S)
+    rule = PAPER_TRIGGERS[env_id](
+        env.observation_space,
+        env.action_space,
+        env.unwrapped.observation_names,
+        **{name: factor * value for name, value in PAPER_THRESHOLDS[env_id]().items()},
     )
-    actions, infos = wrapper_actions(ATTITUDE, demonstrator, **kwargs)
-    sent = np.flatnonzero(np.array(actions).reshape(-1))
-    assert {info["action"] for info in infos} == {0, wrapper.decisions.n_holds}
-    assert np.diff(sent).max() <= heartbeat + 1
-    with pytest.raises(ValueError, match="time_since_transmission_s"):
-        HeartbeatDecision(1, heartbeat, ("a", "b"), 0.001)
+    paired = policy_actions(env_id, HeartbeatPolicy(rule, heartbeat))
+    assert_same(actions, paired)
+    assert_same(policy_actions(env_id, deployed(env_id, follow, **kwargs)), paired)
+    sent = np.flatnonzero(np.array(actions).reshape(len(actions), -1).any(axis=1))
+    assert sent[0] == 0 and np.diff(sent).max() <= heartbeat
+    assert len(sent) > len(actions) / heartbeat  # the rule fires between beats too
 
 
 def test_a_time_limit_sees_every_instant_of_a_hold():
@@ -362,16 +376,6 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ({"decisions": {}, "imitation_decision": "hold 1"}, "imitation_steps"),
         ({"imitation_decision": "hold 1"}, "'imitation_decision' needs the key 'decisions'"),
         (
-            {
-                "decisions": {},
-                "imitation_steps": 8,
-                "imitation_decision": "hold 1",
-                "imitation_heartbeat": 0,
-            },
-            "'imitation_heartbeat' must be an integer >= 1",
-        ),
-        ({"imitation_heartbeat": 8}, "'imitation_heartbeat' needs the key 'imitation_decision'"),
-        (
             {"imitation_pinned_probability": 0.9},
             "'imitation_pinned_probability' needs the key 'imitation_decision'",
         ),
@@ -383,16 +387,6 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
                 "imitation_pinned_probability": 1.0,
             },
             r"'imitation_pinned_probability' must be a number in \(0, 1\)",
-        ),
-        (
-            {
-                "decisions": {},
-                "imitation_steps": 8,
-                "imitation_decision": "hold 1",
-                "imitation_heartbeat": 8,
-                "imitation_pinned_probability": 0.9,
-            },
-            "'imitation_pinned_probability' and 'imitation_heartbeat' exclude each other",
         ),
         (
             {
@@ -468,22 +462,23 @@ def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
     assert (out_dir / "best_model.zip").is_file()
 
 
-def test_cloning_the_rule_with_a_heartbeat_trains_and_deploys(tmp_path):
-    """A short run cloned from "paper x8 with a heartbeat" (``rule_cap`` and
-    ``imitation_heartbeat``) completes, records the demonstrator, and its saved model deploys
-    through ``sb3:`` with the cap in its decision set."""
+def test_the_rule_with_a_heartbeat_trains_pinned_and_deploys(tmp_path):
+    """A short run pinned to "paper x8, heartbeat 12" (``rule_cap`` and ``rule_heartbeat``)
+    completes, records the decision, and its saved model deploys through ``sb3:`` with the
+    heartbeat in its decision set."""
     out_dir, summary = train_cloned(
         tmp_path,
         env_id=ATTITUDE,
         env_kwargs={"horizon_s": 0.3},
-        decisions={"max_exponent": 3, "factors": [8.0], "rule_cap": 12},
+        decisions={"max_exponent": 3, "factors": [8.0], "rule_cap": 12, "rule_heartbeat": True},
         imitation_steps=128,
         imitation_epochs=30,
-        imitation_decision="paper x8",
-        imitation_heartbeat=12,
+        imitation_decision="paper x8, heartbeat 12",
+        imitation_pinned_probability=0.9,
     )
-    assert summary["imitation"]["decision"] == "paper x8, heartbeat 12"
-    assert DecisionSet.load(out_dir / "model.zip").rule_cap == 12
+    assert summary["imitation"]["decision"] == "paper x8, heartbeat 12, pinned at probability 0.9"
+    decisions = DecisionSet.load(out_dir / "model.zip")
+    assert decisions.rule_cap == 12 and decisions.rule_heartbeat
     result = evaluate(ATTITUDE, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
     assert result["episodes"][0]["steps"] == 100
 

@@ -317,21 +317,22 @@ def loop_rule_interval(
     """Compile (once per step and rule) an interval whose instants a triggering rule decides.
 
     The compiled function has the signature ``interval(active, arrays, constants, h, n_steps,
-    cost_scale, transmission_penalty, failure_cost, indices, parameters, instants,
-    stop_on_rule, gamma, actions, discounted, channel_returns, steps_run, step_costs,
+    cost_scale, transmission_penalty, failure_cost, indices, parameters, instants, stop_on_rule,
+    send_first, gamma, actions, discounted, channel_returns, steps_run, step_costs,
     step_sent)``; the arguments from ``arrays`` to ``failure_cost`` are ``loop_step``'s, and
     ``indices``, ``parameters`` those of ``rule(observation, indices, parameters, out)``. At
     each instant every running row's transmit bits are ``rule`` applied to its current
     observation (written to the scratch ``actions``, ``(n, C)`` int64), then ``loop_step``
-    advances the running rows. A row runs ``instants`` instants, or until it fails or reaches
-    the horizon ``n_steps``, or — with ``stop_on_rule`` — until just before a later instant
-    (not the first) at which the rule sends on any channel: that instant is left for the next
-    call. Per row it adds ``gamma**k * reward_k`` to ``discounted`` and each channel's reward
-    to ``channel_returns`` (both summed in order, as a Python loop over the steps would, and
-    not zeroed first), and writes ``steps_run`` and each instant's accuracy cost and transmit
-    bits in ``step_costs[:, k]`` and ``step_sent[:, k]`` (``(n, >= instants)`` and
-    ``(n, >= instants, C)`` arrays). The loop arrays end exactly as after ``steps_run`` calls
-    of ``loop_step`` with the rule's decisions.
+    advances the running rows; with ``send_first``, every channel sends at the first instant
+    whatever the rule decides (a heartbeat). A row runs ``instants`` instants, or until it fails
+    or reaches the horizon ``n_steps``, or — with ``stop_on_rule`` — until just before a later
+    instant (not the first) at which the rule sends on any channel: that instant is left for the
+    next call. Per row it adds ``gamma**k * reward_k`` to ``discounted`` and each channel's
+    reward to ``channel_returns`` (both summed in order, as a Python loop over the steps would,
+    and not zeroed first), and writes ``steps_run`` and each instant's accuracy cost and
+    transmit bits in ``step_costs[:, k]`` and ``step_sent[:, k]`` (``(n, >= instants)`` and
+    ``(n, >= instants, C)`` arrays). The loop arrays end exactly as after ``steps_run`` calls of
+    ``loop_step`` with the rule's decisions.
     """
 
     @closure_jit
@@ -348,6 +349,7 @@ def loop_rule_interval(
         parameters,
         instants,
         stop_on_rule,
+        send_first,
         gamma,
         actions,
         discounted,
@@ -366,6 +368,8 @@ def loop_rule_interval(
                 if not running[i]:
                     continue
                 rule(observations[i], indices, parameters, actions[i])
+                if send_first and instant == 0:
+                    actions[i][:] = 1
                 if stop_on_rule and instant > 0 and actions[i].sum() > 0:
                     running[i] = False
                 else:

@@ -309,11 +309,13 @@ class EventTriggeredEnv(gym.Env):
         return self._interval_outcome(start, outputs)
 
     def run_rule_interval(
-        self, trigger: Any, instants: int, gamma: float = 1.0
+        self, trigger: Any, instants: int, gamma: float = 1.0, send_first: bool = False
     ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
         """Run up to ``instants`` sampling instants decided by a paper's triggering rule in one
         compiled call, ending just before a later instant (not the first) at which the rule
         sends, at a failure or at the horizon: a self-triggered "follow the paper" interval.
+        With ``send_first`` every channel sends at the first instant (the interval of the rule
+        paired with a heartbeat).
 
         ``trigger`` is a :class:`~etsc_envs.triggers.base.RuleTrigger` built for this env's
         observations. The episode ends exactly as after giving :meth:`step` the trigger's
@@ -331,6 +333,7 @@ class EventTriggeredEnv(gym.Env):
             trigger.rule_parameters,
             instants,
             True,
+            bool(send_first),
             gamma,
             self._actions,
             outputs.discounted,

@@ -275,6 +275,7 @@ class EventTriggeredVectorEnv(VectorEnv):
                 trigger.rule_parameters,
                 instants,
                 False,
+                False,
                 1.0,
                 self._actions[start:stop],
                 returns[start:stop],

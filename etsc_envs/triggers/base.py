@@ -186,8 +186,9 @@ class HeartbeatPolicy(TriggerPolicy):
 
     The recurrent ``state`` holds ``trigger``'s state and, per row and channel, the instants
     since that channel's last transmission; pass ``episode_start`` (or ``state=None`` at a reset)
-    to restart them. The episode starts as ``trigger`` decides: the first beat comes
-    ``heartbeat`` instants in, unless a transmission came before.
+    to restart them. Like :class:`PeriodicPolicy`, the heartbeat beats at the episode's first
+    instant; always choosing the self-triggered decision "paper × f, heartbeat H"
+    (:mod:`baselines.self_triggered`) takes the same actions.
     """
 
     def __init__(self, trigger: TriggerPolicy, heartbeat: int) -> None:
@@ -205,14 +206,14 @@ class HeartbeatPolicy(TriggerPolicy):
         inner, silent = state
         inner = self.trigger.reset_state(inner, episode_start, batch)
         silent = np.array(silent)
-        silent[episode_start] = 0
+        silent[episode_start] = self.heartbeat
         return inner, silent
 
     def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
         inner, silent = (None, None) if state is None else state
         channels = 1 if self.n_bits is None else self.n_bits
         if silent is None:
-            silent = np.zeros((len(obs), channels), dtype=np.int64)
+            silent = np.full((len(obs), channels), self.heartbeat, dtype=np.int64)
         decision, inner = self.trigger.transmit(obs, inner)
         sent = np.array(decision, dtype=bool).reshape(len(obs), channels)
         sent[silent.max(axis=1) >= self.heartbeat] = True
