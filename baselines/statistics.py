@@ -10,8 +10,11 @@ Every interval here is a 95 % interval from the field's libraries, never hand-ro
   their IQM with a bootstrap interval, the ratio of the means with a paired bootstrap interval,
   and the probability of improvement ``P(a_i < b_i)`` (ties count one half) with its interval;
 * several training seeds of one method — the IQM over seeds × scenarios of the per-scenario
-  ratios with rliable's stratified bootstrap interval (scenarios are the strata, training runs
-  are resampled within each), and the range of the per-seed IQMs.
+  ratios with rliable's stratified bootstrap interval, resampling the scenarios and the
+  training runs within each (``task_bootstrap``: a scenario set is a sample of its
+  distribution, so the interval must cover other draws of it, not only other seeds; over
+  runs alone, seeds that learned one policy give an interval of zero width), and the range of
+  the per-seed IQMs.
 
 Every bootstrap uses :data:`BOOTSTRAP_RESAMPLES` resamples from a generator seeded with
 :data:`BOOTSTRAP_SEED`, so a JSON file is reproduced digit for digit.
@@ -156,7 +159,7 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
         reference: ``(scenarios,)`` or ``(runs, scenarios)`` values of the reference.
 
     Returns the IQM over runs × scenarios of the per-scenario ratios with rliable's
-    stratified bootstrap interval (``iqm``, ``iqm_ci95``), each run's own IQM (``per_run``)
+    stratified bootstrap interval over scenarios and runs (``iqm``, ``iqm_ci95``), each run's own IQM (``per_run``)
     and their range. Zero references follow :func:`paired_ratio`: 0 / 0 is 1, and a scenario
     where a run is above a zero reference leaves the ratios and is counted in
     ``worse_where_reference_zero``.
@@ -174,6 +177,7 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
     point, interval = rly.get_interval_estimates(
         {"ratio": ratios},
         lambda scores: np.array([metrics.aggregate_iqm(scores)]),
+        task_bootstrap=True,
         reps=BOOTSTRAP_RESAMPLES,
         confidence_interval_size=CONFIDENCE,
         random_state=np.random.RandomState(BOOTSTRAP_SEED),

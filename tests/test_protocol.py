@@ -147,6 +147,20 @@ def test_several_seeds_aggregate_with_the_stratified_bootstrap() -> None:
     assert result["iqm_ci95"][0] <= result["iqm"] <= result["iqm_ci95"][1]
 
 
+def test_seeds_that_learned_one_policy_keep_the_scenarios_spread() -> None:
+    """Identical runs leave no run-to-run variation, but the scenarios are a sample of their
+    distribution: the method's interval is that of one run's per-scenario ratios, not a point."""
+    pytest.importorskip("rliable")
+    rng = np.random.default_rng(7)
+    reference = rng.uniform(1.0, 2.0, 64)
+    one_policy = reference * rng.uniform(0.5, 0.9, 64)
+    result = seeds_ratio(np.vstack([one_policy] * 5), reference)
+    single = paired_ratio(one_policy, reference)
+    assert result["range"][0] == result["range"][1] == pytest.approx(single["iqm"])
+    low, high = result["iqm_ci95"]
+    assert high - low > 0.5 * (single["iqm_ci95"][1] - single["iqm_ci95"][0]) > 0.0
+
+
 def test_a_verdict_is_met_only_when_the_interval_supports_it() -> None:
     cost = {"iqm": 1.0, "iqm_ci95": [0.97, 1.04]}
     sent = {"iqm": 0.5, "iqm_ci95": [0.45, 0.69]}
