@@ -160,9 +160,9 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
 
     Returns the IQM over runs × scenarios of the per-scenario ratios with rliable's
     stratified bootstrap interval over scenarios and runs (``iqm``, ``iqm_ci95``), each run's
-    own IQM (``per_run``) and their range. Zero references follow :func:`paired_ratio`: 0 / 0 is 1, and a scenario
-    where a run is above a zero reference leaves the ratios and is counted in
-    ``worse_where_reference_zero``.
+    own IQM (``per_run``) and their range. Zero references follow :func:`paired_ratio`: 0 / 0
+    is 1, and a scenario where a run is above a zero reference leaves the ratios and is counted
+    in ``worse_where_reference_zero``.
     """
     from rliable import library as rly
     from rliable import metrics
