@@ -212,8 +212,8 @@ def imitate_decision(
     ``model``, a learner of self-triggered decisions, from ``steps`` decisions on its own
     training env; with ``pinned_probability``, the action head is then pinned to the decision
     (:func:`pin_decision`; the fit still sets the value head and the observation statistics).
-    Returns the fit's summary, its ``agreement`` the
-    pinned policy's where pinned."""
+    Returns the fit's summary; where pinned, its ``agreement`` is the pinned policy's and
+    ``clone_agreement`` the fit's."""
     action = decisions.action(label)
     env = model.get_env()
     gamma = float(getattr(model, "gamma", 0.99))

@@ -413,6 +413,18 @@ def test_training_config_checks_the_decisions(tmp_path, changes, message):
         config_from_dict({**config, **changes})
 
 
+VALIDATED_FORMATION_RUN = {
+    "env_id": FORMATION,
+    "env_kwargs": {"horizon_s": 0.2},
+    "decisions": {"max_exponent": 3},
+    "evaluation_every": 32,
+    "evaluation_scenarios": 2,
+    "evaluation_env_kwargs": {"horizon_s": 0.1},
+}
+"""A self-triggered 004 run validated on two 0.1-s scenarios every 32 decisions (2 envs x 32
+steps per rollout): the first validation is the policy before reinforcement."""
+
+
 def train_cloned(tmp_path, **keys) -> tuple[Path, dict]:
     """``agents.train`` on a short self-triggered config cloned before 32 steps of PPO (2 envs),
     with ``keys`` replaced; the run's folder and its ``train_summary.json``."""
@@ -443,15 +455,10 @@ def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
     validated before reinforcement starts."""
     out_dir, summary = train_cloned(
         tmp_path,
-        env_id=FORMATION,
-        env_kwargs={"horizon_s": 0.2},
-        decisions={"max_exponent": 3},
+        **VALIDATED_FORMATION_RUN,
         imitation_steps=256,
         imitation_epochs=60,
         imitation_decision="paper x0.5",
-        evaluation_every=32,
-        evaluation_scenarios=2,
-        evaluation_env_kwargs={"horizon_s": 0.1},
     )
     imitation = summary["imitation"]
     assert imitation["decision"] == "paper x0.5" and imitation["steps"] == 256
@@ -517,16 +524,11 @@ def test_agents_train_pins_the_cloned_decision(tmp_path):
     decision on every demonstration, and the model validated first is that decision."""
     out_dir, summary = train_cloned(
         tmp_path,
-        env_id=FORMATION,
-        env_kwargs={"horizon_s": 0.2},
-        decisions={"max_exponent": 3},
+        **VALIDATED_FORMATION_RUN,
         imitation_steps=64,
         imitation_epochs=2,
         imitation_decision="hold 8",
         imitation_pinned_probability=0.9,
-        evaluation_every=32,
-        evaluation_scenarios=2,
-        evaluation_env_kwargs={"horizon_s": 0.1},
     )
     imitation = summary["imitation"]
     assert imitation["decision"] == "hold 8, pinned at probability 0.9"

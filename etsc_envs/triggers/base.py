@@ -182,7 +182,7 @@ class HeartbeatPolicy(TriggerPolicy):
     """A trigger paired with a heartbeat: ``trigger``'s decisions, and every channel at an
     instant where ``heartbeat`` instants have passed since some channel last transmitted, so no
     channel goes more than ``heartbeat`` instants without a transmission (an event trigger with
-    a clock as its backstop; the checkout's self-triggered training clones the same pairing).
+    a clock as its backstop).
 
     The recurrent ``state`` holds ``trigger``'s state and, per row and channel, the instants
     since that channel's last transmission; pass ``episode_start`` (or ``state=None`` at a reset)
