@@ -87,7 +87,7 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
-from agents.decisions import SelfTriggeredWrapper
+from agents.decisions import make_decision_env
 from baselines.cli import require_env_id
 from baselines.policies import require_model_fits
 from etsc_envs.core.files import require_writable_folder
@@ -302,8 +302,6 @@ def _check_decisions(
             raise ValueError("config key 'imitation_decision' needs the key 'decisions'")
         return None
     decisions = _check_mapping("decisions", values["decisions"])
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        raise ValueError(f"config key 'decisions' needs a Gymnasium id, got {env_id}")
     if bool(values["imitation_steps"]) != (label is not None):
         raise ValueError(
             "config keys 'imitation_steps' and 'imitation_decision' go together with "
@@ -315,7 +313,7 @@ def _check_decisions(
     if unknown:
         raise ValueError(f"config key 'decisions': {unknown} are not among {list(allowed)}")
     try:
-        wrapper = SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), **decisions)
+        wrapper = make_decision_env(env_id, env_kwargs, decisions)
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
     try:
@@ -349,7 +347,7 @@ def policy_spaces(
     PettingZoo id; the decisions' with ``decisions``), from one env built with
     ``env_kwargs``."""
     if decisions is not None:
-        env = SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), **decisions)
+        env = make_decision_env(env_id, env_kwargs, decisions)
         spaces = env.observation_space, env.action_space
     elif env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env = etsc_envs.make_parallel(env_id, **env_kwargs)

@@ -19,7 +19,9 @@ unless it trains with the buffers and callback of :mod:`agents.elapsed_discount`
 shield's mask for sb3-contrib's ``MaskablePPO``; an unsafe action given anyway is replaced as
 :meth:`~baselines.self_triggered.IntervalSchedule.shielded` says (``info["action"]`` is the one
 run). A model trained here deploys as a transmit/hold policy once its decision set is saved
-beside it (``wrapper.decisions.save(model_path)``).
+beside it (``wrapper.decisions.save(model_path)``). A PettingZoo id's agents take their
+decisions apart, in :class:`agents.follower_decisions.FollowerDecisionEnv`;
+:func:`make_decision_env` builds whichever of the two an id takes.
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import OrderEnforcing, PassiveEnvChecker
 
+import etsc_envs
+from agents.follower_decisions import FollowerDecisionEnv
 from baselines.self_triggered import (
     DEFAULT_MAX_EXPONENT,
     DecisionSet,
@@ -56,7 +60,8 @@ def interval_env(env: gym.Env) -> EventTriggeredEnv | None:
 
 class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     """Decisions over intervals of a transmit/hold env built by ``gym.make`` (its id names the
-    paper trigger; Gymnasium ids only: the PettingZoo cluster is not wrapped).
+    paper trigger; Gymnasium ids only: a PettingZoo id's agents decide in
+    :class:`~agents.follower_decisions.FollowerDecisionEnv`).
 
     Args:
         env: the transmit/hold env.
@@ -194,3 +199,21 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             if terminated or truncated:
                 break
         return observation, total, terminated, truncated, info, instant + 1
+
+
+def make_decision_env(
+    env_id: str,
+    env_kwargs: dict[str, Any],
+    decisions: dict[str, Any],
+    gamma: float = 0.99,
+    teammate_decision: str | None = None,
+) -> SelfTriggeredWrapper | FollowerDecisionEnv:
+    """Self-triggered decisions in ``env_id`` built with ``env_kwargs``: a
+    :class:`SelfTriggeredWrapper` over ``gym.make`` for a Gymnasium id, one agent's
+    :class:`~agents.follower_decisions.FollowerDecisionEnv` for a PettingZoo id (its teammates
+    taking ``teammate_decision`` until they follow a model; ``None``: the paper's rule).
+    ``decisions`` holds the decision set's keywords."""
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        teammates = {} if teammate_decision is None else {"teammate_decision": teammate_decision}
+        return FollowerDecisionEnv(env_id, env_kwargs, gamma=gamma, **decisions, **teammates)
+    return SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), gamma=gamma, **decisions)

@@ -107,8 +107,7 @@ class PaperComparisonCallback(BaseCallback):
         setup = episode_setup(self.env_id, self.env_kwargs)
         paper_trigger = setup.make_policy("paper", {})
         if self.decisions is not None:
-            spaces = setup.env.observation_space, setup.env.action_space
-            names = setup.env.unwrapped.observation_names
+            *spaces, names = setup.policy_spaces()
             self._deployment = (IntervalSchedule(self.decisions, *spaces, names), *spaces)
         setup.env.close()
         self.paper = set_summary(self._run(paper_trigger))

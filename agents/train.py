@@ -55,7 +55,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, Ve
 
 import etsc_envs
 from agents.config import TrainConfig, load_config
-from agents.decisions import SelfTriggeredWrapper
+from agents.decisions import make_decision_env
 from agents.elapsed_discount import (
     ElapsedRolloutBuffer,
     ElapsedStepsCallback,
@@ -183,6 +183,8 @@ def _train(
                 config.imitation_steps,
                 config.imitation_epochs,
             )
+    if decisions is not None and config.env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env.env_method("follow_model", model)  # parameter sharing: teammates act as the model
     metrics_callback = EpisodeMetricsCallback()
     start = time.perf_counter()
     periodic = _periodic_callbacks(config, out_dir, env.num_envs, checkpoint, decisions)
@@ -269,13 +271,16 @@ def _discounts_elapsed_instants(config: TrainConfig) -> bool:
     return config.decisions is not None and config.algorithm in ELAPSED_BUFFERS
 
 
-def make_decision_env(config: TrainConfig) -> SelfTriggeredWrapper:
+def training_decision_env(config: TrainConfig) -> gym.Env:
     """One env of ``config.env_id`` taking ``config.decisions``, discounting within an interval
-    by the algorithm's ``gamma``."""
-    return SelfTriggeredWrapper(
-        gym.make(config.env_id, **config.env_kwargs),
+    by the algorithm's ``gamma`` (for a PettingZoo id, one agent's decisions, its teammates
+    taking ``imitation_decision`` until they follow the model)."""
+    return make_decision_env(
+        config.env_id,
+        config.env_kwargs,
+        config.decisions,
         gamma=config.hyperparameters.get("gamma", 0.99),
-        **config.decisions,
+        teammate_decision=config.imitation_decision,
     )
 
 
@@ -506,14 +511,14 @@ def _periodic_callbacks(
 def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> VecEnv:
     """``config.n_envs`` environments of ``config.env_id`` as one SB3 ``VecEnv`` with episode
     statistics and, as configured, normalisation (restored from ``checkpoint``'s statistics
-    when resuming): with ``decisions``, a ``DummyVecEnv`` of :func:`make_decision_env`; else
+    when resuming): with ``decisions``, a ``DummyVecEnv`` of :func:`training_decision_env`; else
     the id's native vector env through :class:`SB3VecEnvAdapter` when it has
     one (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs; for a PettingZoo id,
     every agent of the shared loops' vector env
     (:class:`~agents.vector_adapter.SharedPolicyVecEnv`)."""
     if config.decisions is not None:
         env: VecEnv = make_vec_env(
-            functools.partial(make_decision_env, config),
+            functools.partial(training_decision_env, config),
             n_envs=config.n_envs,
             seed=config.seed,
             vec_env_cls=DummyVecEnv,

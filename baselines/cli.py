@@ -101,6 +101,19 @@ class EpisodeSetup(NamedTuple):
     run: Callable[..., tuple[dict[str, Any], Any]]
     """:func:`~baselines.episodes.run_episode` or its PettingZoo form."""
 
+    def policy_spaces(self) -> tuple[gym.Space, gym.Space, tuple[str, ...]]:
+        """The observation space, action space and observation names a policy acts with
+        (one agent's, for a PettingZoo id)."""
+        env = self.env
+        if callable(env.observation_space):
+            agent = env.possible_agents[0]
+            return (
+                env.observation_space(agent),
+                env.action_space(agent),
+                tuple(env.unwrapped.agent_observation_names),
+            )
+        return env.observation_space, env.action_space, tuple(env.unwrapped.observation_names)
+
 
 def require_env_id(env_id: Any, argument: str = "env_id") -> str:
     """``env_id`` if it is registered with Gymnasium or a PettingZoo id of etsc-envs, else

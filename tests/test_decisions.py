@@ -546,3 +546,31 @@ def test_agents_train_pins_the_cloned_decision(tmp_path):
     assert first["timesteps"] == 0
     assert first["learned"]["transmissions"] == clock["transmissions"]
     assert first["learned"]["mean_cost"] == pytest.approx(clock["mean_cost"], rel=1e-12)
+
+
+def test_the_decentralised_cluster_trains_pinned_and_deploys(tmp_path):
+    """A PettingZoo id takes self-triggered decisions one follower at a time
+    (:class:`agents.follower_decisions.FollowerDecisionEnv`): a short pinned run completes,
+    its teammates act as the model, and the saved model deploys through ``sb3:`` on every
+    follower of the PettingZoo env, as the pinned decision does."""
+    cluster = "etsc/ClusterContainment-v0"
+    out_dir, summary = train_cloned(
+        tmp_path,
+        env_id=cluster,
+        env_kwargs={"horizon_s": 2.0},
+        decisions={"max_exponent": 4, "factors": [1.0, 1.5]},
+        imitation_steps=64,
+        imitation_epochs=5,
+        imitation_decision="paper x1.5",
+        imitation_pinned_probability=0.9,
+    )
+    assert summary["imitation"]["decision"] == "paper x1.5, pinned at probability 0.9"
+    assert DecisionSet.load(out_dir / "model.zip").env_id == cluster
+    env_args = {"horizon_s": 20.0}
+    learned = evaluate(cluster, f"sb3:{out_dir / 'model.zip'}", env_args=env_args, seed=SEED)
+    rule = evaluate(cluster, "paper", policy_args={"c": 0.9}, env_args=env_args, seed=SEED)
+    learned, rule = learned["episodes"][0], rule["episodes"][0]
+    assert learned["transmissions"] == rule["transmissions"] > 0
+    assert learned["mean_cost"] == rule["mean_cost"]
+    for agent, record in rule["agents"].items():
+        assert learned["agents"][agent]["transmissions"] == record["transmissions"]

@@ -1,0 +1,127 @@
+"""One follower's self-triggered decisions in the decentralised cluster (paper 001), its
+teammates following the shared policy: the training env against the deployed transmit/hold
+policy that ``baselines.evaluate`` runs, step for step (short horizons)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import etsc_envs
+from agents.follower_decisions import FollowerDecisionEnv
+from baselines.episodes import run_parallel_episode
+from baselines.self_triggered import SelfTriggeredPolicy
+from etsc_envs.triggers import PAPER_TRIGGERS
+
+CLUSTER = "etsc/ClusterContainment-v0"
+HORIZON_S = 3.0
+DECISIONS = {"max_exponent": 5, "factors": (0.5, 1.0, 1.5)}
+
+
+class ScriptedSharedModel:
+    """A stand-in for a model being trained: a decision that varies with the observation, and
+    no observation statistics."""
+
+    def __init__(self, n_actions: int) -> None:
+        self.n_actions = n_actions
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        digits = np.abs(np.asarray(observation)).sum(axis=1) * 1e3
+        return digits.astype(np.int64) % self.n_actions, None
+
+    def get_vec_normalize_env(self):
+        return None
+
+
+def follower_env(horizon_s: float = HORIZON_S, **kwargs) -> FollowerDecisionEnv:
+    return FollowerDecisionEnv(CLUSTER, {"horizon_s": horizon_s}, **{**DECISIONS, **kwargs})
+
+
+@pytest.mark.parametrize("seed", [0, 5])
+def test_training_episode_is_the_deployed_policy_step_for_step(seed):
+    """The learner acting as the model its teammates follow: the training episode is the
+    evaluation episode of the deployed policy, agent for agent, and the learner is paid exactly
+    its own channel's rewards."""
+    env = follower_env(gamma=1.0)
+    model = ScriptedSharedModel(env.action_space.n)
+    env.follow_model(model)
+    observation, info = env.reset(seed=seed)
+    learner_return, decisions, actions = 0.0, 0, set()
+    while True:
+        action = int(model.predict(observation[None])[0][0])
+        observation, reward, terminated, truncated, info = env.step(action)
+        learner_return += reward
+        decisions += 1
+        actions.add(info["action"])
+        if terminated or truncated:
+            break
+    training = info["episode_metrics"]
+    assert len(actions) > 2 and decisions > 10  # the scripted decisions vary
+
+    parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=HORIZON_S)
+    agent = parallel.possible_agents[0]
+    deployed = SelfTriggeredPolicy(
+        model, env.schedule, parallel.observation_space(agent), parallel.action_space(agent)
+    )
+    record, _ = run_parallel_episode(parallel, deployed, seed=seed)
+    for name in parallel.possible_agents:
+        assert training["agents"][name]["transmissions"] == record["agents"][name]["transmissions"]
+    assert training["mean_cost"] == record["mean_cost"]
+    learner = parallel.possible_agents[env.learner]
+    assert learner_return == pytest.approx(record["agents"][learner]["return"], rel=1e-12)
+
+
+def test_every_follower_is_the_learner_under_some_seed():
+    env = follower_env()
+    learners = {env.reset(seed=seed)[1]["learner"] for seed in range(40)}
+    assert learners == set(range(env.n_agents))
+    assert env.reset(seed=7)[1]["learner"] == env.reset(seed=7)[1]["learner"]
+
+
+def test_teammates_take_the_fixed_decision_until_they_follow_a_model():
+    """Before ``follow_model`` every teammate takes ``teammate_decision``: with the learner
+    taking it too, each follower updates as eq. (15)'s rule at that c does alone (20 s: the
+    rule first fires after a few seconds)."""
+    env = follower_env(horizon_s=20.0, teammate_decision="paper x1.5")
+    env.reset(seed=2)
+    action = env.decisions.action("paper x1.5")
+    while True:
+        _, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            break
+    parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=20.0)
+    agent = parallel.possible_agents[0]
+    paper = PAPER_TRIGGERS[CLUSTER](
+        parallel.observation_space(agent),
+        parallel.action_space(agent),
+        parallel.unwrapped.agent_observation_names,
+        c=0.9,  # 1.5 x the paper's c = 0.6
+    )
+    record, _ = run_parallel_episode(parallel, paper, seed=2)
+    assert record["transmissions"] > 0
+    for name in parallel.possible_agents:
+        assert (
+            info["episode_metrics"]["agents"][name]["transmissions"]
+            == record["agents"][name]["transmissions"]
+        )
+
+
+def test_follower_env_passes_gymnasium_check_env():
+    check_env(follower_env(), skip_render_check=True)
+
+
+def test_bad_arguments_name_themselves():
+    with pytest.raises(ValueError, match="env_id: 'etsc/ClusterContainmentCentral-v0'"):
+        FollowerDecisionEnv("etsc/ClusterContainmentCentral-v0")
+    with pytest.raises(ValueError, match="gamma"):
+        follower_env(gamma=1.5)
+    with pytest.raises(ValueError, match="'paper x9' is not a decision"):
+        follower_env(teammate_decision="paper x9")
+    env = follower_env()
+    with pytest.raises(gym.error.ResetNeeded):
+        env.step(0)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action must be one integer"):
+        env.step(env.action_space.n)
