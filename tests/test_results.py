@@ -5,14 +5,16 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip("stable_baselines3")
 
 from stable_baselines3 import PPO
 
-from agents.results import equal_rate_period, main, markdown
+from agents.results import clock_verdict, equal_rate_period, main, markdown, verdict_text
 from agents.vector_adapter import make_sb3_vec_env
+from baselines.statistics import paired_ratio
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 SHORT = {"horizon_s": 0.05}
@@ -69,3 +71,30 @@ def test_one_model_makes_no_claim(tmp_path: Path) -> None:
     result = json.loads((out_dir / "results.json").read_text(encoding="utf-8"))
     assert not result["sets"]["paper"]["method"]["claim"]
     assert "no claim: 1 training seed(s)" in markdown(result)
+
+
+def fake_result(costs: list[float], transmissions: list[int]) -> dict:
+    """An evaluation result with one record per scenario (what ``clock_verdict`` reads)."""
+    return {
+        "episodes": [
+            {"mean_cost": cost, "transmissions": sent, "failure": None}
+            for cost, sent in zip(costs, transmissions, strict=True)
+        ]
+    }
+
+
+@pytest.mark.parametrize(
+    ("periodic_costs", "tie", "text"),
+    [
+        ([1.0, 2.0, 3.0, 4.0], True, "tie (the learned trigger transmits as the clock"),
+        ([1.1, 2.2, 3.3, 4.4], False, "**met**"),
+        ([0.9, 1.8, 2.7, 3.6], False, "not met (cost ratio upper bound"),
+    ],
+)
+def test_a_learned_trigger_that_is_the_clock_is_a_tie(periodic_costs, tie, text) -> None:
+    learned = fake_result([1.0, 2.0, 3.0, 4.0], [10, 10, 10, 10])
+    periodic = fake_result(periodic_costs, [10, 10, 10, 10])
+    costs = [[record["mean_cost"] for record in r["episodes"]] for r in (learned, periodic)]
+    result = clock_verdict(paired_ratio(*map(np.array, costs)), learned, periodic)
+    assert result["tie"] is tie
+    assert verdict_text(result).startswith(text)
