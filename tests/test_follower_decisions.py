@@ -108,8 +108,11 @@ def test_teammates_take_the_fixed_decision_until_they_follow_a_model():
         )
 
 
-def test_follower_env_passes_gymnasium_check_env():
+def test_follower_env_passes_the_gymnasium_and_sb3_env_checkers():
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
     check_env(follower_env(), skip_render_check=True)
+    sb3_check_env(follower_env())
 
 
 def test_bad_arguments_name_themselves():
