@@ -38,7 +38,6 @@ from baselines.self_triggered import (
     DEFAULT_MAX_EXPONENT,
     DecisionSet,
     IntervalSchedule,
-    default_factors,
 )
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.validation import require_discount
@@ -104,7 +103,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.decisions = DecisionSet(
             env.spec.id,
             max_exponent=max_exponent,
-            factors=default_factors(env.spec.id) if factors is None else tuple(factors),
+            factors=factors,
             shield_multiple=shield_multiple,
             sampling_period_s=float(unwrapped.params.sampling_period_s),
             rule_cap=rule_cap,
@@ -136,10 +135,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         (the action run) and ``shielded`` (whether the shield replaced the one given)."""
         if self._observation is None:
             raise gym.error.ResetNeeded("call reset() before step()")
-        given = np.asarray(action).reshape(-1)
-        if given.size != 1 or not self.action_space.contains(np.int64(given[0])):
-            raise ValueError(f"action must be one integer in {self.action_space}, got {action!r}")
-        given = int(given[0])
+        given = self.decisions.require_action(action)
         obs = self._observation[None]
         chosen = self.schedule.shielded(np.array([given]), obs)
         following = int(chosen[0]) - self.decisions.n_holds
@@ -214,6 +210,7 @@ def make_decision_env(
     taking ``teammate_decision`` until they follow a model; ``None``: the paper's rule).
     ``decisions`` holds the decision set's keywords."""
     if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        teammates = {} if teammate_decision is None else {"teammate_decision": teammate_decision}
-        return FollowerDecisionEnv(env_id, env_kwargs, gamma=gamma, **decisions, **teammates)
+        return FollowerDecisionEnv(
+            env_id, env_kwargs, gamma=gamma, teammate_decision=teammate_decision, **decisions
+        )
     return SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), gamma=gamma, **decisions)

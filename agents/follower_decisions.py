@@ -28,39 +28,18 @@ import numpy as np
 
 import etsc_envs
 from agents.imitation import FixedDecision
+from baselines.policies import NormalizedModel
 from baselines.self_triggered import (
     DEFAULT_MAX_EXPONENT,
     DecisionSet,
     IntervalSchedule,
     SelfTriggeredPolicy,
-    default_factors,
 )
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.validation import require_discount
 
 DEFAULT_TEAMMATE_DECISION = "paper x1"
 """The teammates' decision until :meth:`FollowerDecisionEnv.follow_model`: the paper's rule."""
-
-
-class LiveNormalizedModel:
-    """A model being trained, answering ``predict`` on raw observations through its current
-    ``VecNormalize`` statistics (read, never updated), deterministically."""
-
-    def __init__(self, model: Any) -> None:
-        self.model = model
-
-    def predict(
-        self,
-        observation: np.ndarray,
-        state: Any = None,
-        episode_start: np.ndarray | None = None,
-        deterministic: bool = True,
-    ) -> tuple[np.ndarray, Any]:
-        normalization = self.model.get_vec_normalize_env()
-        if normalization is not None:
-            observation = normalization.normalize_obs(observation)
-        actions, _ = self.model.predict(observation, deterministic=True)
-        return actions, state
 
 
 class FollowerDecisionEnv(gym.Env):
@@ -74,7 +53,8 @@ class FollowerDecisionEnv(gym.Env):
             (:class:`~baselines.self_triggered.DecisionSet`; ``factors`` ``None``: the id's
             default).
         gamma: the per-instant discount within an interval (in (0, 1]).
-        teammate_decision: the label of the teammates' decision until :meth:`follow_model`.
+        teammate_decision: the label of the teammates' decision until :meth:`follow_model`
+            (``None``: :data:`DEFAULT_TEAMMATE_DECISION`).
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
@@ -89,7 +69,7 @@ class FollowerDecisionEnv(gym.Env):
         gamma: float = 0.99,
         rule_cap: int | None = None,
         rule_heartbeat: bool = False,
-        teammate_decision: str = DEFAULT_TEAMMATE_DECISION,
+        teammate_decision: str | None = None,
     ) -> None:
         if env_id not in etsc_envs.PETTINGZOO_ENV_IDS:
             raise ValueError(
@@ -106,7 +86,7 @@ class FollowerDecisionEnv(gym.Env):
         self.decisions = DecisionSet(
             env_id,
             max_exponent=max_exponent,
-            factors=default_factors(env_id) if factors is None else tuple(factors),
+            factors=factors,
             shield_multiple=shield_multiple,
             sampling_period_s=float(self.loop.params.sampling_period_s),
             rule_cap=rule_cap,
@@ -122,7 +102,7 @@ class FollowerDecisionEnv(gym.Env):
         self.action_space = self.decisions.action_space
         self.n_agents = len(self.parallel_env.possible_agents)
         self.teammates = SelfTriggeredPolicy(
-            FixedDecision(self.decisions.action(teammate_decision)),
+            FixedDecision(self.decisions.action(teammate_decision or DEFAULT_TEAMMATE_DECISION)),
             self.schedule,
             agent_observations,
             agent_actions,
@@ -134,9 +114,13 @@ class FollowerDecisionEnv(gym.Env):
 
     def follow_model(self, model: Any) -> None:
         """From now on the teammates decide as ``model`` does (a self-triggered model being
-        trained, read through its current observation statistics)."""
+        trained, read deterministically through its live observation statistics)."""
+        normalization = model.get_vec_normalize_env()
+        reader = (
+            model if normalization is None else NormalizedModel(model, normalization, freeze=False)
+        )
         self.teammates = SelfTriggeredPolicy(
-            LiveNormalizedModel(model),
+            reader,
             self.schedule,
             self.teammates.observation_space,
             self.teammates.action_space,
@@ -164,11 +148,11 @@ class FollowerDecisionEnv(gym.Env):
         ``elapsed_steps``, ``action`` (the action run), ``shielded`` and ``learner``."""
         if self._observations is None:
             raise gym.error.ResetNeeded("call reset() before step()")
-        given = np.asarray(action).reshape(-1)
-        if given.size != 1 or not self.action_space.contains(np.int64(given[0])):
-            raise ValueError(f"action must be one integer in {self.action_space}, got {action!r}")
+        given = self.decisions.require_action(action)
         learner = self.learner
-        chosen = int(self.schedule.shielded(given, self._observations[learner][None])[0])
+        chosen = int(
+            self.schedule.shielded(np.array([given]), self._observations[learner][None])[0]
+        )
         self._state[learner] = self.schedule.start(np.array([chosen]))[0]
         total, steps = 0.0, 0
         while True:
@@ -187,19 +171,19 @@ class FollowerDecisionEnv(gym.Env):
             **info,
             "elapsed_steps": steps,
             "action": chosen,
-            "shielded": chosen != int(given[0]),
+            "shielded": chosen != given,
             "learner": learner,
         }
         return self._observations[learner].copy(), total, terminated, truncated, info
 
     def _start_teammates(self) -> None:
         """Start the next interval of every teammate whose interval has ended."""
-        deciding = self._deciding.copy()
+        deciding = self._deciding
         deciding[self.learner] = False
         if deciding.any():
             actions = self.teammates.choose(self._observations[deciding])
             self._state[deciding] = self.schedule.start(actions)
-        self._deciding[:] = False
+            deciding[:] = False
 
     def close(self) -> None:
         self.parallel_env.close()

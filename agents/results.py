@@ -242,7 +242,7 @@ def _method(rows: list[dict[str, Any]], paper: dict[str, Any]) -> dict[str, Any]
         ),
         "beats_periodic": {
             **verdict(periodic, worst, worst_clock, 1.0),
-            "tie": all(row["beats_periodic"].get("tie", False) for row in rows),
+            "tie": all(row["beats_periodic"]["tie"] for row in rows),
         },
     }
 

@@ -167,18 +167,22 @@ def normalization_path(model_path: str | Path) -> Path:
 
 
 class NormalizedModel:
-    """A Stable-Baselines3 model that reads observations through saved ``VecNormalize``
-    statistics (frozen: evaluation does not update them).
+    """A Stable-Baselines3 model that reads observations through ``VecNormalize`` statistics
+    (``predict`` never updates them).
 
     Args:
         model: the loaded model.
         normalization: the unpickled ``VecNormalize`` (its ``venv`` may be unset).
+        freeze: switch the statistics' own updates off (``training = False``), as evaluation
+            wants; ``False`` reads the live statistics of a run still training, which its
+            training env goes on updating.
     """
 
-    def __init__(self, model: Any, normalization: Any) -> None:
+    def __init__(self, model: Any, normalization: Any, freeze: bool = True) -> None:
         self.model = model
         self.normalization = normalization
-        self.normalization.training = False
+        if freeze:
+            self.normalization.training = False
         self.observation_space = model.observation_space
         self.action_space = model.action_space
 

@@ -80,7 +80,8 @@ class DecisionSet:
     Args:
         env_id: the transmit/hold id the decisions act in.
         max_exponent: k, the longest hold is 2^k sampling instants (an integer >= 0).
-        factors: the scalings f > 0 of the paper's threshold, one action each.
+        factors: the scalings f > 0 of the paper's threshold, one action each (``None``: the
+            id's default, :func:`default_factors`).
         shield_multiple: the shield's bound (for 004, sampling errors within this many Π), or
             ``None`` for no shield.
         sampling_period_s: the env's sampling period (s), which the shield converts holds
@@ -94,7 +95,7 @@ class DecisionSet:
 
     env_id: str
     max_exponent: int = DEFAULT_MAX_EXPONENT
-    factors: tuple[float, ...] = DEFAULT_FACTORS
+    factors: tuple[float, ...] | None = None
     shield_multiple: float | None = None
     sampling_period_s: float | None = None
     rule_cap: int | None = None
@@ -106,7 +107,8 @@ class DecisionSet:
         exponent = self.max_exponent
         if isinstance(exponent, bool) or not isinstance(exponent, int) or not 0 <= exponent <= 20:
             raise ValueError(f"max_exponent must be an integer in 0..20, got {exponent!r}")
-        factors = tuple(float(f) for f in self.factors)
+        given = default_factors(self.env_id) if self.factors is None else self.factors
+        factors = tuple(float(f) for f in given)
         if not all(np.isfinite(f) and f > 0.0 for f in factors):
             raise ValueError(f"factors must be finite numbers > 0, got {self.factors!r}")
         object.__setattr__(self, "factors", factors)
@@ -159,6 +161,14 @@ class DecisionSet:
         if label not in labels:
             raise ValueError(f"{label!r} is not a decision of this set; its decisions: {labels}")
         return labels.index(label)
+
+    def require_action(self, action: Any) -> int:
+        """``action`` (a scalar or a one-element array) as an action of the set; ``ValueError``
+        naming it and the set's actions otherwise."""
+        given = np.asarray(action).reshape(-1)
+        if given.size != 1 or not self.action_space.contains(np.int64(given[0])):
+            raise ValueError(f"action must be one integer in {self.action_space}, got {action!r}")
+        return int(given[0])
 
     def save(self, model_path: str | Path) -> Path:
         """Write the set beside the model saved at ``model_path`` (:func:`decision_set_path`)."""

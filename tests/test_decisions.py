@@ -574,3 +574,12 @@ def test_the_decentralised_cluster_trains_pinned_and_deploys(tmp_path):
     assert learned["mean_cost"] == rule["mean_cost"]
     for agent, record in rule["agents"].items():
         assert learned["agents"][agent]["transmissions"] == record["transmissions"]
+
+
+def test_a_decision_set_takes_its_ids_default_factors():
+    from baselines.self_triggered import DEFAULT_FACTORS, default_factors
+
+    cluster = "etsc/ClusterContainment-v0"
+    assert DecisionSet(cluster).factors == default_factors(cluster) != DEFAULT_FACTORS
+    assert DecisionSet(ATTITUDE).factors == DEFAULT_FACTORS
+    assert DecisionSet(ATTITUDE, factors=[2, 8]).factors == (2.0, 8.0)
