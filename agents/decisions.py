@@ -74,6 +74,8 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         rule_cap: the longest "paper × f" interval in instants (``None``: 2^max_exponent).
         rule_heartbeat: whether "paper × f" intervals transmit at their decision instant
             (the rule paired with a heartbeat of ``rule_cap`` instants).
+        rule: the family of the rule actions, ``paper`` or ``error_time``
+            (:class:`~baselines.self_triggered.DecisionSet`).
     """
 
     def __init__(
@@ -85,6 +87,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         gamma: float = 0.99,
         rule_cap: int | None = None,
         rule_heartbeat: bool = False,
+        rule: str = "paper",
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -94,6 +97,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             gamma=gamma,
             rule_cap=rule_cap,
             rule_heartbeat=rule_heartbeat,
+            rule=rule,
         )
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
@@ -108,6 +112,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             sampling_period_s=float(unwrapped.params.sampling_period_s),
             rule_cap=rule_cap,
             rule_heartbeat=rule_heartbeat,
+            rule=rule,
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names

@@ -49,7 +49,7 @@ class FollowerDecisionEnv(gym.Env):
     Args:
         env_id: the PettingZoo id (:data:`etsc_envs.PETTINGZOO_ENV_IDS`).
         env_kwargs: its keyword arguments.
-        max_exponent, factors, shield_multiple, rule_cap, rule_heartbeat: the decision set's
+        max_exponent, factors, shield_multiple, rule_cap, rule_heartbeat, rule: the decision set's
             (:class:`~baselines.self_triggered.DecisionSet`; ``factors`` ``None``: the id's
             default).
         gamma: the per-instant discount within an interval (in (0, 1]).
@@ -69,6 +69,7 @@ class FollowerDecisionEnv(gym.Env):
         gamma: float = 0.99,
         rule_cap: int | None = None,
         rule_heartbeat: bool = False,
+        rule: str = "paper",
         teammate_decision: str | None = None,
     ) -> None:
         if env_id not in etsc_envs.PETTINGZOO_ENV_IDS:
@@ -91,6 +92,7 @@ class FollowerDecisionEnv(gym.Env):
             sampling_period_s=float(self.loop.params.sampling_period_s),
             rule_cap=rule_cap,
             rule_heartbeat=rule_heartbeat,
+            rule=rule,
         )
         self.schedule = IntervalSchedule(
             self.decisions,

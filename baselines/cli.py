@@ -15,10 +15,10 @@ from baselines.episodes import run_episode, run_parallel_episode, to_jsonable
 from baselines.policies import load_sb3
 from baselines.self_triggered import decision_set_path, load_self_triggered
 from etsc_envs.core.files import atomic_write_text
-from etsc_envs.triggers import PAPER_TRIGGERS, AlwaysPolicy, PeriodicPolicy
+from etsc_envs.triggers import RULE_FAMILIES, AlwaysPolicy, PeriodicPolicy
 from etsc_envs.triggers.base import HeartbeatPolicy
 
-POLICY_CHOICES = "paper | periodic | always | sb3:PATH_TO_ZIP"
+POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP"
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
 (:mod:`baselines.self_triggered`)."""
 
@@ -167,13 +167,14 @@ def _policy_for(
         return AlwaysPolicy(observation_space, action_space, **policy_args)
     if spec == "periodic":
         return PeriodicPolicy(observation_space, action_space, **policy_args)
-    if spec == "paper":
-        if env_id not in PAPER_TRIGGERS:
-            raise ValueError(f"no paper trigger for {env_id}; known: {sorted(PAPER_TRIGGERS)}")
+    if spec in RULE_FAMILIES:
+        triggers = RULE_FAMILIES[spec][0]
+        if env_id not in triggers:
+            raise ValueError(f"no {spec} trigger for {env_id}; known: {sorted(triggers)}")
         names = observation_names()
         arguments = dict(policy_args)
         heartbeat = arguments.pop("heartbeat", None)
-        trigger = PAPER_TRIGGERS[env_id](observation_space, action_space, names, **arguments)
+        trigger = triggers[env_id](observation_space, action_space, names, **arguments)
         return trigger if heartbeat is None else HeartbeatPolicy(trigger, heartbeat)
     if spec.startswith("sb3:"):
         if policy_args:

@@ -5,7 +5,9 @@
         [--episodes N] [--seed S] [--json PATH|-] [--plot DIR]
 
 POLICY is ``paper`` (the paper's triggering rule; ``--policy-arg heartbeat=H`` pairs it with a
-heartbeat, a transmission on every channel once H instants passed without one), ``periodic``
+heartbeat, a transmission on every channel once H instants passed without one), ``error_time``
+(paper 004's error-time rule, ``--policy-arg area=A`` in m·s,
+:data:`etsc_envs.triggers.ERROR_TIME_TRIGGERS`; ``heartbeat=H`` pairs it too), ``periodic``
 (``--policy-arg every=K``), ``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3
 model). ``--scenarios`` runs a fixed scenario set of the test protocol (docs/protocol.md);
 ``--episodes/--seed`` run ad-hoc draws instead. The JSON holds every episode's record, the

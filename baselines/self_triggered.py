@@ -9,7 +9,9 @@ An action of :class:`DecisionSet` is one of
   (:data:`etsc_envs.triggers.PAPER_THRESHOLDS`) scaled by f decides every instant, the
   decision instant included; the interval ends just before a later instant at which it fires
   (on any channel), after 2^k instants (or the set's ``rule_cap``), or with the episode.
-  Always choosing f = 1 is the paper's trigger.
+  Always choosing f = 1 is the paper's trigger. A set whose ``rule`` is ``error_time`` offers
+  the id's error-time rule (:data:`etsc_envs.triggers.ERROR_TIME_TRIGGERS`) the same way,
+  labelled **error_time × f**.
 * **paper × f, heartbeat H** (a set with ``rule_heartbeat``, H its ``rule_cap``): as paper × f,
   but every channel transmits at the decision instant. The interval ends just before the rule
   fires or H instants after that transmission, so always choosing it is the rule paired with a
@@ -42,7 +44,7 @@ import numpy as np
 
 from baselines.policies import load_sb3, takes_action_masks
 from etsc_envs.core.files import atomic_write_text
-from etsc_envs.triggers import PAPER_SHIELDS, PAPER_THRESHOLDS, PAPER_TRIGGERS
+from etsc_envs.triggers import PAPER_SHIELDS, PAPER_TRIGGERS, RULE_FAMILIES
 from etsc_envs.triggers.base import batched_observations, transmit_bits
 
 DEFAULT_MAX_EXPONENT = 10
@@ -91,6 +93,9 @@ class DecisionSet:
         rule_heartbeat: whether a "paper × f" interval transmits every channel at its decision
             instant, making it "paper × f, heartbeat ``rule_cap``" (see the module's
             description).
+        rule: the family of the rule actions (:data:`etsc_envs.triggers.RULE_FAMILIES`):
+            ``paper`` (the paper's trigger) or ``error_time`` (the id's error-time rule, which
+            the shield does not cover); it names them (``paper x2``, ``error_time x2``).
     """
 
     env_id: str
@@ -100,6 +105,7 @@ class DecisionSet:
     sampling_period_s: float | None = None
     rule_cap: int | None = None
     rule_heartbeat: bool = False
+    rule: str = "paper"
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -119,8 +125,20 @@ class DecisionSet:
             raise ValueError(f"rule_cap must be an integer in 1..{2**20} or None, got {cap!r}")
         if not isinstance(self.rule_heartbeat, bool):
             raise ValueError(f"rule_heartbeat must be true or false, got {self.rule_heartbeat!r}")
+        if self.rule not in RULE_FAMILIES:
+            raise ValueError(f"rule must be one of {sorted(RULE_FAMILIES)}, got {self.rule!r}")
+        if self.env_id not in RULE_FAMILIES[self.rule][0]:
+            raise ValueError(
+                f"rule: no {self.rule} rule for {self.env_id}; it exists for "
+                f"{sorted(RULE_FAMILIES[self.rule][0])}"
+            )
         if self.shield_multiple is None:
             return
+        if self.rule != "paper":
+            raise ValueError(
+                f"shield_multiple: the shield bounds the paper rule's factors only; a set with "
+                f"rule {self.rule!r} must have shield_multiple null"
+            )
         if self.env_id not in PAPER_SHIELDS:
             raise ValueError(
                 f"shield_multiple: no shield for {self.env_id}; shields exist for "
@@ -149,10 +167,11 @@ class DecisionSet:
         return gym.spaces.Discrete(self.n_holds + len(self.factors))
 
     def label(self, action: int) -> str:
-        """``action`` in words (``hold 8``, ``paper x2``, ``paper x2, heartbeat 384``)."""
+        """``action`` in words (``hold 8``, ``paper x2``, ``paper x2, heartbeat 384``,
+        ``error_time x2``)."""
         if action < self.n_holds:
             return f"hold {int(self.hold_steps[action])}"
-        label = f"paper x{self.factors[action - self.n_holds]:g}"
+        label = f"{self.rule} x{self.factors[action - self.n_holds]:g}"
         return f"{label}, heartbeat {self.rule_steps}" if self.rule_heartbeat else label
 
     def action(self, label: str) -> int:
@@ -188,22 +207,23 @@ class DecisionSet:
             raise ValueError(f"decision set {path} is not readable ({error})") from None
 
 
-def scaled_paper_trigger(
+def scaled_rule_trigger(
     env_id: str,
     factor: float,
     observation_space: gym.Space,
     action_space: gym.Space,
     observation_names: tuple[str, ...],
+    rule: str = "paper",
 ) -> Any:
-    """The paper trigger of ``env_id`` with its threshold keywords
-    (:data:`~etsc_envs.triggers.PAPER_THRESHOLDS`) scaled by ``factor``; ``ValueError`` naming
-    ``factors`` when the scaled values leave the trigger's range."""
-    thresholds = PAPER_THRESHOLDS[env_id]()
-    scaled = {name: factor * value for name, value in thresholds.items()}
+    """The ``rule`` trigger of ``env_id`` (:data:`~etsc_envs.triggers.RULE_FAMILIES`) with its
+    threshold keywords scaled by ``factor``; ``ValueError`` naming ``factors`` when the scaled
+    values leave the trigger's range."""
+    triggers, thresholds = RULE_FAMILIES[rule]
+    scaled = {name: factor * value for name, value in thresholds[env_id]().items()}
     try:
-        return PAPER_TRIGGERS[env_id](observation_space, action_space, observation_names, **scaled)
+        return triggers[env_id](observation_space, action_space, observation_names, **scaled)
     except ValueError as error:
-        raise ValueError(f"factors: {factor:g} x the paper's threshold: {error}") from None
+        raise ValueError(f"factors: {factor:g} x the {rule} rule's threshold: {error}") from None
 
 
 class IntervalSchedule:
@@ -227,8 +247,13 @@ class IntervalSchedule:
         self.decisions = decisions
         self.n_bits = transmit_bits(action_space)
         self.triggers = [
-            scaled_paper_trigger(
-                decisions.env_id, factor, observation_space, action_space, observation_names
+            scaled_rule_trigger(
+                decisions.env_id,
+                factor,
+                observation_space,
+                action_space,
+                observation_names,
+                decisions.rule,
             )
             for factor in decisions.factors
         ]

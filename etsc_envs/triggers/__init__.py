@@ -1,6 +1,7 @@
 """Reference trigger policies: the papers' own triggering rules (one module per problem, looked
-up by environment id in :data:`PAPER_TRIGGERS`) and the time-triggered references
-:class:`AlwaysPolicy` and :class:`PeriodicPolicy`.
+up by environment id in :data:`PAPER_TRIGGERS`), the time-triggered references
+:class:`AlwaysPolicy` and :class:`PeriodicPolicy`, and other event rules on the same signals
+(:data:`ERROR_TIME_TRIGGERS`); :data:`RULE_FAMILIES` names each family of rules.
 
 Every policy answers like a Stable-Baselines3 model, ``predict(obs, state=None,
 episode_start=None, deterministic=True) -> (action, state)``::
@@ -23,8 +24,10 @@ from etsc_envs.triggers.attitude_tracking import PAPER_PSI, AttitudeTrackingTrig
 from etsc_envs.triggers.base import AlwaysPolicy, PeriodicPolicy, TriggerPolicy
 from etsc_envs.triggers.cluster import PAPER_C, ClusterContainmentTrigger
 from etsc_envs.triggers.inner_formation import (
+    InnerFormationErrorTimeTrigger,
     InnerFormationShield,
     InnerFormationTrigger,
+    default_error_time_thresholds,
     default_thresholds,
 )
 from etsc_envs.triggers.orbit_attitude import PAPER_GAMMA, OrbitAttitudeTrigger
@@ -58,6 +61,31 @@ before transmitting, at the paper's values (a larger value waits longer; paper 0
 fires more bursts with a larger α: a later burst meets a larger drift, and its saturated
 correction overshoots, docs/results.md)."""
 
+ERROR_TIME_TRIGGERS = {"etsc/InnerFormation-v0": InnerFormationErrorTimeTrigger}
+"""Environment id → its error-time rule: a channel transmits when its sampling error times the
+time since its last transmission passes a threshold (:class:`InnerFormationErrorTimeTrigger`
+says why), on the ids whose observation carries a per-channel sampling error."""
+
+
+def _inner_formation_error_time_thresholds() -> dict[str, float]:
+    area1, area2, area3 = default_error_time_thresholds()
+    return {"area1": float(area1), "area2": float(area2), "area3": float(area3)}
+
+
+ERROR_TIME_THRESHOLDS: dict[str, Callable[[], dict[str, float]]] = {
+    "etsc/InnerFormation-v0": _inner_formation_error_time_thresholds,
+}
+"""Environment id → the threshold keywords of its error-time rule at their defaults."""
+
+RULE_FAMILIES = {
+    "paper": (PAPER_TRIGGERS, PAPER_THRESHOLDS),
+    "error_time": (ERROR_TIME_TRIGGERS, ERROR_TIME_THRESHOLDS),
+}
+"""Rule name → (environment id → trigger class, environment id → its threshold keywords): the
+event rules whose thresholds a self-triggered decision set scales
+(:class:`baselines.self_triggered.DecisionSet`'s ``rule``) and :mod:`baselines.evaluate` runs
+(``--policy paper`` or ``--policy error_time``)."""
+
 PAPER_SHIELDS = {
     "etsc/InnerFormation-v0": InnerFormationShield,
     "etsc/AsteroidOrbitKeeping-v0": AsteroidShield,
@@ -66,14 +94,18 @@ PAPER_SHIELDS = {
 ids whose papers give a condition under which a hold is unsafe."""
 
 __all__ = [
+    "ERROR_TIME_THRESHOLDS",
+    "ERROR_TIME_TRIGGERS",
     "PAPER_SHIELDS",
     "PAPER_THRESHOLDS",
     "PAPER_TRIGGERS",
+    "RULE_FAMILIES",
     "AlwaysPolicy",
     "AsteroidOrbitKeepingTrigger",
     "AsteroidShield",
     "AttitudeTrackingTrigger",
     "ClusterContainmentTrigger",
+    "InnerFormationErrorTimeTrigger",
     "InnerFormationTrigger",
     "OrbitAttitudeTrigger",
     "PeriodicPolicy",

@@ -1,4 +1,5 @@
-"""The per-axis send-on-delta conditions eqs. (4)-(6) of paper 004 as a trigger policy."""
+"""The per-axis send-on-delta conditions eqs. (4)-(6) of paper 004 as a trigger policy, and the
+error-time rule on the same sampling errors (a reference trigger beside the paper's)."""
 
 from __future__ import annotations
 
@@ -65,6 +66,81 @@ class InnerFormationTrigger(RuleTrigger):
         )
 
     rule = staticmethod(inner_formation_rule)
+
+
+ERROR_TIME_REFERENCE_S = 0.05
+"""The default error-time thresholds are Π_i × this (s): near the mean interval between an
+axis's transmissions under the paper's rule at Π_i on the paper scenario (12 840 transmissions
+of 3 axes in 200 s, 47 ms), so that factor 1 sends about as often as the paper's rule."""
+
+
+def default_error_time_thresholds() -> np.ndarray:
+    """A_i = Π_i × :data:`ERROR_TIME_REFERENCE_S` (m·s), with Π_i of :func:`default_thresholds`."""
+    return default_thresholds() * ERROR_TIME_REFERENCE_S
+
+
+@jit
+def inner_formation_error_time_rule(observation, indices, parameters, out):
+    """The error-time rule on one observation: axis i transmits when |r_i(t) - r_i(t_k)| ·
+    (t - t_k) (``sampling_error_m_*`` at ``indices[i]``, ``time_since_transmission_s_*`` at
+    ``indices[3 + i]``) > A_i (``parameters[i]``)."""
+    for axis in range(3):
+        error = abs(float(observation[indices[axis]]))
+        elapsed = float(observation[indices[3 + axis]])
+        out[axis] = 1 if error * elapsed > parameters[axis] else 0
+
+
+class InnerFormationErrorTimeTrigger(RuleTrigger):
+    """Axis i transmits when its sampling error times the time since its last transmission,
+    |r_i(t) - r_i(t_k)| · (t - t_k), passes A_i (not a rule of paper 004: a reference beside it).
+
+    Why this product: an axis whose measurement drifts at speed v_i accumulates a sampling error
+    v_i τ, so an interval of length h costs ∫ |r_i - r_i(t_k)| dt = v_i h² / 2. For a given
+    number of transmissions that integral is least when their density is ∝ √v_i, h ∝ 1/√v_i.
+    Eqs. (4)-(6) transmit at h = Π_i / v_i (density ∝ v_i) and a clock at a constant h
+    (density independent of v_i): the two ends of the family h ∝ v_i^(-p). The product
+    |r_i - r_i(t_k)| τ ≈ v_i τ² passes A_i at τ = √(A_i / v_i), the optimum's p = 1/2. The
+    sampling error enters the env's per-step cost Σ_i |r_i - ζ_i| through the observer, which
+    tracks the held measurement (eq. 3). docs/results.md compares it with the paper's rule and
+    the clock.
+
+    Args:
+        area: one threshold A for all axes (m·s), or
+        area1, area2, area3: per-axis thresholds (m·s). Unset thresholds default to
+            :func:`default_error_time_thresholds`.
+    """
+
+    def __init__(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        observation_names: tuple[str, ...],
+        area: float | None = None,
+        area1: float | None = None,
+        area2: float | None = None,
+        area3: float | None = None,
+    ) -> None:
+        thresholds = default_error_time_thresholds() if area is None else np.full(3, float(area))
+        for axis, value in enumerate((area1, area2, area3)):
+            if value is not None:
+                thresholds[axis] = float(value)
+        if not np.all(np.isfinite(thresholds)) or np.any(thresholds <= 0.0):
+            raise ValueError(
+                f"area, area1, area2, area3 must be finite numbers > 0 (m·s), got {thresholds}"
+            )
+        self.thresholds = thresholds
+        names = [f"sampling_error_m_{a}" for a in AXES] + [
+            f"time_since_transmission_s_{axis}" for axis in range(3)
+        ]
+        super().__init__(
+            observation_space,
+            action_space,
+            indices=[observation_names.index(name) for name in names],
+            parameters=thresholds,
+            keywords={"area1": thresholds[0], "area2": thresholds[1], "area3": thresholds[2]},
+        )
+
+    rule = staticmethod(inner_formation_error_time_rule)
 
 
 def predicted_sampling_error(velocity_estimate: np.ndarray, hold_s: np.ndarray) -> np.ndarray:
