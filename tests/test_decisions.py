@@ -20,7 +20,7 @@ from baselines.policies import load_sb3, takes_action_masks
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
 from etsc_envs.triggers import PAPER_THRESHOLDS, PAPER_TRIGGERS, PeriodicPolicy
 from etsc_envs.triggers.asteroid import AsteroidShield
-from etsc_envs.triggers.inner_formation import InnerFormationShield
+from etsc_envs.triggers.inner_formation import InnerFormationShield, default_error_time_thresholds
 
 ATTITUDE = "etsc/AttitudeTracking-v0"
 FORMATION = "etsc/InnerFormation-v0"
@@ -372,6 +372,7 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ({"algorithm": "MaskablePPO"}, "MaskablePPO needs the key 'decisions'"),
         ({"decisions": {"max_exponent": 3, "holds": 2}}, "'decisions'"),
         ({"decisions": {"shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
+        ({"decisions": {"rule": "error_time"}, "env_id": ATTITUDE}, "no error_time rule"),
         ({"decisions": {}, "imitation_steps": 64}, "imitation_steps"),
         ({"decisions": {}, "imitation_decision": "hold 1"}, "imitation_steps"),
         ({"imitation_decision": "hold 1"}, "'imitation_decision' needs the key 'decisions'"),
@@ -488,6 +489,34 @@ def test_the_rule_with_a_heartbeat_trains_pinned_and_deploys(tmp_path):
     assert decisions.rule_cap == 12 and decisions.rule_heartbeat
     result = evaluate(ATTITUDE, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
     assert result["episodes"][0]["steps"] == 100
+
+
+def test_the_error_time_rule_trains_pinned_and_deploys(tmp_path):
+    """A short 004 run pinned to "error_time x2" (a set whose rule is ``error_time``) saves a
+    model whose deployed policy, through ``sb3:``, is the error-time rule at twice its default
+    thresholds, instant for instant."""
+    out_dir, summary = train_cloned(
+        tmp_path,
+        env_id=FORMATION,
+        env_kwargs={"horizon_s": 0.3},
+        decisions={"max_exponent": 3, "rule": "error_time", "factors": [1.0, 2.0]},
+        imitation_steps=128,
+        imitation_epochs=30,
+        imitation_decision="error_time x2",
+        imitation_pinned_probability=0.9,
+    )
+    assert summary["imitation"]["decision"] == "error_time x2, pinned at probability 0.9"
+    assert DecisionSet.load(out_dir / "model.zip").rule == "error_time"
+    env = gym.make(FORMATION, horizon_s=0.3)
+    learned = RecordedActions(gym.make(FORMATION, horizon_s=0.3))
+    run_episode(learned, make_policy(f"sb3:{out_dir / 'model.zip'}", env, {}, FORMATION), SEED)
+    rule = RecordedActions(gym.make(FORMATION, horizon_s=0.3))
+    doubled = {
+        f"area{axis + 1}": 2 * area for axis, area in enumerate(default_error_time_thresholds())
+    }
+    run_episode(rule, make_policy("error_time", env, doubled, FORMATION), SEED)
+    assert np.array(rule.actions).any()
+    assert_same(learned.actions, rule.actions)
 
 
 def test_a_pinned_decision_is_the_policy_everywhere(tmp_path):

@@ -12,6 +12,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
+from baselines.self_triggered import scaled_rule_trigger
 from etsc_envs import ENV_IDS
 from etsc_envs.triggers import PAPER_THRESHOLDS, PAPER_TRIGGERS, PeriodicPolicy
 
@@ -235,3 +236,29 @@ def test_a_rule_interval_refuses_a_trigger_of_another_env():
         env.unwrapped.run_rule_interval(
             PeriodicPolicy(other.observation_space, other.action_space, every=2), 4
         )
+
+
+def test_an_error_time_interval_equals_the_rules_steps():
+    """The error-time rule of 004 (a RuleTrigger beside the paper's) runs compiled intervals
+    that end where the stepped rule sends again, bit for bit."""
+    env_id = "etsc/InnerFormation-v0"
+    compiled, stepwise = pair(env_id, horizon_s=0.5, randomize=True)
+    triggers = [
+        scaled_rule_trigger(
+            env_id,
+            factor,
+            compiled.observation_space,
+            compiled.action_space,
+            compiled.unwrapped.observation_names,
+            "error_time",
+        )
+        for factor in (0.05, 0.2)
+    ]
+    n_steps = compiled.unwrapped.n_steps
+    lengths = []
+    while compiled.unwrapped.step_index < n_steps:
+        trigger = triggers[len(lengths) % len(triggers)]
+        got = compiled.unwrapped.run_rule_interval(trigger, n_steps, 0.99)
+        assert_same_loop(compiled, stepwise, got, rule_stepped(stepwise, trigger, n_steps, 0.99))
+        lengths.append(got[5])
+    assert got[3] and len(lengths) > 2
