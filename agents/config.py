@@ -57,7 +57,7 @@ A config is a YAML mapping with these keys (the optional ones show their default
   training starts from the fixed decision exactly rather than from a fit of it;
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
-  ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``; its ``gamma`` is
+  ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``, ``rule_floor``; its ``gamma`` is
   ``hyperparameters.gamma``), on a ``DummyVecEnv`` of
   wrapped envs (Gymnasium ids only; cloning with ``imitation_decision``). PPO, A2C and MaskablePPO
   then discount by elapsed instants (:mod:`agents.elapsed_discount`); the models are saved with
@@ -308,7 +308,15 @@ def _check_decisions(
             "'decisions' (the decision to clone, and for how many decisions), got "
             f"imitation_steps={values['imitation_steps']!r}, imitation_decision={label!r}"
         )
-    allowed = ("max_exponent", "factors", "shield_multiple", "rule_cap", "rule_heartbeat", "rule")
+    allowed = (
+        "max_exponent",
+        "factors",
+        "shield_multiple",
+        "rule_cap",
+        "rule_heartbeat",
+        "rule",
+        "rule_floor",
+    )
     unknown = sorted(set(decisions) - set(allowed))
     if unknown:
         raise ValueError(f"config key 'decisions': {unknown} are not among {list(allowed)}")

@@ -76,6 +76,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             (the rule paired with a heartbeat of ``rule_cap`` instants).
         rule: the family of the rule actions, ``paper`` or ``error_time``
             (:class:`~baselines.self_triggered.DecisionSet`).
+        rule_floor: the floor of "paper × f, floor F" actions in instants, or ``None``.
     """
 
     def __init__(
@@ -88,6 +89,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         rule_cap: int | None = None,
         rule_heartbeat: bool = False,
         rule: str = "paper",
+        rule_floor: int | None = None,
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -98,6 +100,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule_cap=rule_cap,
             rule_heartbeat=rule_heartbeat,
             rule=rule,
+            rule_floor=rule_floor,
         )
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
@@ -113,6 +116,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule_cap=rule_cap,
             rule_heartbeat=rule_heartbeat,
             rule=rule,
+            rule_floor=rule_floor,
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names
@@ -149,7 +153,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
                 self.schedule.triggers[following],
                 self.decisions.rule_steps,
                 self.gamma,
-                send_first=self.decisions.rule_heartbeat,
+                send_first=self.decisions.rule_sends_first,
             )
         else:
             observation, total, terminated, truncated, info, steps = self._run_schedule(chosen)

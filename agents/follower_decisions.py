@@ -49,7 +49,8 @@ class FollowerDecisionEnv(gym.Env):
     Args:
         env_id: the PettingZoo id (:data:`etsc_envs.PETTINGZOO_ENV_IDS`).
         env_kwargs: its keyword arguments.
-        max_exponent, factors, shield_multiple, rule_cap, rule_heartbeat, rule: the decision set's
+        max_exponent, factors, shield_multiple, rule_cap, rule_heartbeat, rule, rule_floor: the
+            decision set's
             (:class:`~baselines.self_triggered.DecisionSet`; ``factors`` ``None``: the id's
             default).
         gamma: the per-instant discount within an interval (in (0, 1]).
@@ -70,6 +71,7 @@ class FollowerDecisionEnv(gym.Env):
         rule_cap: int | None = None,
         rule_heartbeat: bool = False,
         rule: str = "paper",
+        rule_floor: int | None = None,
         teammate_decision: str | None = None,
     ) -> None:
         if env_id not in etsc_envs.PETTINGZOO_ENV_IDS:
@@ -93,6 +95,7 @@ class FollowerDecisionEnv(gym.Env):
             rule_cap=rule_cap,
             rule_heartbeat=rule_heartbeat,
             rule=rule,
+            rule_floor=rule_floor,
         )
         self.schedule = IntervalSchedule(
             self.decisions,

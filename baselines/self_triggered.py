@@ -17,6 +17,12 @@ An action of :class:`DecisionSet` is one of
   fires or H instants after that transmission, so always choosing it is the rule paired with a
   heartbeat of H instants (:class:`~etsc_envs.triggers.base.HeartbeatPolicy`; on a
   multi-channel id, an instant at which the rule fires on some channel sends every channel).
+* **paper × f, floor F** (a set with ``rule_floor`` F): every channel transmits at the decision
+  instant, holds the next F - 1 instants, and from then on the rule decides; the interval ends
+  just before an instant at which it fires (or after ``rule_cap``). Always choosing it is the
+  rule gating a clock: transmit when the rule fires and F instants have passed since the last
+  transmission (:func:`~etsc_envs.triggers.base.floored_trigger_class`, a minimum inter-event
+  time; on a multi-channel id every channel transmits at the decision instant).
 
 A multi-channel id (``MultiBinary``: 004, the central cluster) shares one interval: a hold
 sends every channel, the paper's rule sends the channels it names. :class:`IntervalSchedule`
@@ -45,7 +51,12 @@ import numpy as np
 from baselines.policies import load_sb3, takes_action_masks
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.triggers import PAPER_SHIELDS, PAPER_TRIGGERS, RULE_FAMILIES
-from etsc_envs.triggers.base import batched_observations, transmit_bits
+from etsc_envs.triggers.base import (
+    batched_observations,
+    floor_seconds,
+    floored_trigger_class,
+    transmit_bits,
+)
 
 DEFAULT_MAX_EXPONENT = 10
 """Longest hold 2^10 = 1024 sampling instants."""
@@ -93,6 +104,8 @@ class DecisionSet:
         rule_heartbeat: whether a "paper × f" interval transmits every channel at its decision
             instant, making it "paper × f, heartbeat ``rule_cap``" (see the module's
             description).
+        rule_floor: the floor F of "paper × f, floor F" actions (an integer in 1..2^20, at most
+            ``rule_cap``; needs ``sampling_period_s``), or ``None`` for none.
         rule: the family of the rule actions (:data:`etsc_envs.triggers.RULE_FAMILIES`):
             ``paper`` (the paper's trigger) or ``error_time`` (the id's error-time rule, which
             the shield does not cover); it names them (``paper x2``, ``error_time x2``).
@@ -106,6 +119,7 @@ class DecisionSet:
     rule_cap: int | None = None
     rule_heartbeat: bool = False
     rule: str = "paper"
+    rule_floor: int | None = None
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -125,6 +139,19 @@ class DecisionSet:
             raise ValueError(f"rule_cap must be an integer in 1..{2**20} or None, got {cap!r}")
         if not isinstance(self.rule_heartbeat, bool):
             raise ValueError(f"rule_heartbeat must be true or false, got {self.rule_heartbeat!r}")
+        floor = self.rule_floor
+        if floor is not None:
+            if isinstance(floor, bool) or not isinstance(floor, int) or not 1 <= floor <= 2**20:
+                raise ValueError(
+                    f"rule_floor must be an integer in 1..{2**20} or None, got {floor!r}"
+                )
+            if floor > self.rule_steps:
+                raise ValueError(
+                    f"rule_floor ({floor}) must be at most the longest rule interval "
+                    f"({self.rule_steps}: rule_cap, else 2^max_exponent)"
+                )
+            if self.sampling_period_s is None:
+                raise ValueError("sampling_period_s must be given with rule_floor")
         if self.rule not in RULE_FAMILIES:
             raise ValueError(f"rule must be one of {sorted(RULE_FAMILIES)}, got {self.rule!r}")
         if self.env_id not in RULE_FAMILIES[self.rule][0]:
@@ -172,7 +199,15 @@ class DecisionSet:
         if action < self.n_holds:
             return f"hold {int(self.hold_steps[action])}"
         label = f"{self.rule} x{self.factors[action - self.n_holds]:g}"
+        if self.rule_floor is not None:
+            label = f"{label}, floor {self.rule_floor}"
         return f"{label}, heartbeat {self.rule_steps}" if self.rule_heartbeat else label
+
+    @property
+    def rule_sends_first(self) -> bool:
+        """Whether a rule interval transmits every channel at its decision instant (with a
+        heartbeat or a floor)."""
+        return self.rule_heartbeat or self.rule_floor is not None
 
     def action(self, label: str) -> int:
         """The action :meth:`label` names ``label``; ``ValueError`` listing the labels if none."""
@@ -214,13 +249,20 @@ def scaled_rule_trigger(
     action_space: gym.Space,
     observation_names: tuple[str, ...],
     rule: str = "paper",
+    floor_s: float | None = None,
 ) -> Any:
     """The ``rule`` trigger of ``env_id`` (:data:`~etsc_envs.triggers.RULE_FAMILIES`) with its
-    threshold keywords scaled by ``factor``; ``ValueError`` naming ``factors`` when the scaled
-    values leave the trigger's range."""
+    threshold keywords scaled by ``factor``, with a floor of ``floor_s`` seconds if given
+    (:func:`~etsc_envs.triggers.base.floored_trigger_class`); ``ValueError`` naming ``factors``
+    when the scaled values leave the trigger's range."""
     triggers, thresholds = RULE_FAMILIES[rule]
     scaled = {name: factor * value for name, value in thresholds[env_id]().items()}
     try:
+        if floor_s is not None:
+            floored = floored_trigger_class(triggers[env_id])
+            return floored(
+                observation_space, action_space, observation_names, floor_s=floor_s, **scaled
+            )
         return triggers[env_id](observation_space, action_space, observation_names, **scaled)
     except ValueError as error:
         raise ValueError(f"factors: {factor:g} x the {rule} rule's threshold: {error}") from None
@@ -246,6 +288,11 @@ class IntervalSchedule:
     ) -> None:
         self.decisions = decisions
         self.n_bits = transmit_bits(action_space)
+        floor_s = (
+            None
+            if decisions.rule_floor is None
+            else floor_seconds(decisions.rule_floor, decisions.sampling_period_s)
+        )
         self.triggers = [
             scaled_rule_trigger(
                 decisions.env_id,
@@ -254,6 +301,7 @@ class IntervalSchedule:
                 action_space,
                 observation_names,
                 decisions.rule,
+                floor_s,
             )
             for factor in decisions.factors
         ]
@@ -330,7 +378,7 @@ class IntervalSchedule:
     def transmit(self, obs: np.ndarray, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Each row's transmit decision at the instant of ``obs`` (booleans, one column per
         channel for ``MultiBinary``) and the state after it."""
-        sends_first = (state[:, 0] < self.decisions.n_holds) | self.decisions.rule_heartbeat
+        sends_first = (state[:, 0] < self.decisions.n_holds) | self.decisions.rule_sends_first
         first = sends_first & (state[:, 1] == 0)
         decision = self._rule_fires(obs, state)
         decision[first] = True

@@ -219,3 +219,90 @@ class HeartbeatPolicy(TriggerPolicy):
         sent[silent.max(axis=1) >= self.heartbeat] = True
         silent = np.where(sent, 1, silent + 1)
         return (sent[:, 0] if self.n_bits is None else sent), (inner, silent)
+
+
+TIME_SINCE_TRANSMISSION = "time_since_transmission_s"
+"""The prefix of the observation components that hold each channel's time since its last
+transmission (s): one per channel, in channel order."""
+
+
+def time_since_transmission_indices(observation_names: tuple[str, ...]) -> list[int]:
+    """The observation indices of the channels' times since transmission, in channel order."""
+    return [
+        index
+        for index, name in enumerate(observation_names)
+        if name.startswith(TIME_SINCE_TRANSMISSION)
+    ]
+
+
+@functools.cache
+def floored_rule(rule: Callable[..., None]) -> Callable[..., None]:
+    """The compiled kernel of ``rule`` with a floor: ``rule``'s decisions, except that a channel
+    whose time since transmission (the last ``C`` entries of ``indices``, C the channels) is
+    below the floor (the last entry of ``parameters``, s) holds. ``rule`` reads its own
+    indices and parameters by position, ahead of those entries."""
+
+    @closure_jit
+    def floored(observation, indices, parameters, out):
+        rule(observation, indices, parameters, out)
+        n_channels = out.shape[0]
+        first_time = indices.shape[0] - n_channels
+        floor_s = parameters[parameters.shape[0] - 1]
+        for channel in range(n_channels):
+            if float(observation[indices[first_time + channel]]) < floor_s:
+                out[channel] = 0
+
+    return floored
+
+
+@functools.cache
+def floored_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
+    """A :class:`RuleTrigger` class whose triggers are those of ``trigger_class`` with a floor:
+    a channel transmits when ``trigger_class``'s rule fires for it and at least ``floor_s``
+    seconds have passed since its last transmission (a minimum inter-event time, the rule
+    gating a clock). Built with ``(observation_space, action_space, observation_names,
+    floor_s, **keywords)``, ``keywords`` those of ``trigger_class``; one class per rule, so the
+    compiled loop compiles each floored rule once. At a reset the time since transmission is
+    0, so a floored trigger alone first transmits once the floor has passed; a decision set's
+    floored action transmits at its decision instant (:mod:`baselines.self_triggered`)."""
+
+    class FlooredTrigger(RuleTrigger):
+        rule = staticmethod(floored_rule(trigger_class.rule))
+
+        def __init__(
+            self,
+            observation_space: gym.Space,
+            action_space: gym.Space,
+            observation_names: tuple[str, ...],
+            floor_s: float,
+            **keywords: Any,
+        ) -> None:
+            floor_s = float(floor_s)
+            if not np.isfinite(floor_s) or floor_s <= 0.0:
+                raise ValueError(f"floor_s must be a finite number > 0 (s), got {floor_s!r}")
+            inner = trigger_class(observation_space, action_space, observation_names, **keywords)
+            times = time_since_transmission_indices(observation_names)
+            if len(times) != inner.n_channels:
+                raise ValueError(
+                    f"observation_names must hold one {TIME_SINCE_TRANSMISSION}* per channel "
+                    f"({inner.n_channels}), got {len(times)}"
+                )
+            self.floor_s = floor_s
+            self.inner = inner
+            super().__init__(
+                observation_space,
+                action_space,
+                indices=[*inner.rule_indices, *times],
+                parameters=[*inner.rule_parameters, floor_s],
+                keywords={**inner.keywords, "floor_s": floor_s},
+            )
+
+    FlooredTrigger.__name__ = FlooredTrigger.__qualname__ = f"Floored{trigger_class.__name__}"
+    return FlooredTrigger
+
+
+def floor_seconds(floor: int, sampling_period_s: float) -> float:
+    """The ``floor_s`` of a floor of ``floor`` sampling instants: a channel that transmitted at
+    instant k may transmit again from instant k + ``floor`` on (its time since transmission
+    there is ``floor`` periods; half a period below, so float32 observations compare safely)."""
+    return (int(floor) - 0.5) * float(sampling_period_s)

@@ -1,0 +1,133 @@
+"""A rule with a floor (a minimum inter-event time: the rule gating a clock), as a trigger and
+as the "paper × f, floor F" decisions of a decision set: it never transmits sooner than the
+floor, transmits only where the rule fires, equals the stand-alone floored trigger instant for
+instant, and refuses bad arguments."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import etsc_envs  # noqa: F401  (registers the ids)
+from agents.decisions import SelfTriggeredWrapper
+from baselines.episodes import run_episode
+from baselines.self_triggered import DecisionSet
+from etsc_envs.triggers import OrbitAttitudeTrigger
+from etsc_envs.triggers.base import floor_seconds, floored_trigger_class
+from tests.test_decisions import RecordedActions
+
+ORBIT = "etsc/OrbitAttitudeTracking-v0"
+FORMATION = "etsc/InnerFormation-v0"
+SAMPLING_PERIOD_S = 1e-3
+HORIZON_S = 1.5
+GAMMAS = {"gamma1": 0.004, "gamma2": 0.012}
+"""Eq. (21) at four times the paper's absolute thresholds."""
+
+
+def floored(env: gym.Env, floor: int, **keywords) -> OrbitAttitudeTrigger:
+    trigger_class = floored_trigger_class(OrbitAttitudeTrigger)
+    return trigger_class(
+        env.observation_space,
+        env.action_space,
+        env.unwrapped.observation_names,
+        floor_s=floor_seconds(floor, SAMPLING_PERIOD_S),
+        **keywords,
+    )
+
+
+def transmission_instants(actions: list[np.ndarray]) -> np.ndarray:
+    return np.flatnonzero(np.array(actions).reshape(len(actions), -1).any(axis=1))
+
+
+@pytest.mark.parametrize("floor", [16, 64])
+def test_a_floored_rule_waits_the_floor_and_fires_only_with_the_rule(floor):
+    """Consecutive transmissions are at least ``floor`` instants apart, and at each one (past
+    the floor) the rule alone would fire on that observation."""
+    env = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
+    trigger = floored(env, floor, **GAMMAS)
+    rule = OrbitAttitudeTrigger(
+        env.observation_space, env.action_space, env.unwrapped.observation_names, **GAMMAS
+    )
+    observations = []
+    policy = ObservationLog(trigger, observations)
+    run_episode(env, policy, seed=2)
+    instants = transmission_instants(env.actions)
+    assert len(instants) > 5
+    assert np.diff(instants).min() >= floor
+    fired, _ = rule.predict(np.array(observations)[instants])
+    assert fired.all()
+    held = np.setdiff1d(np.arange(len(observations)), instants)
+    early = held[held < instants[0]]
+    assert early.size >= floor - 1
+
+
+def test_a_floored_rule_is_the_clock_where_the_rule_always_fires():
+    """With thresholds so small that eq. (21) fires at every instant the floor is a clock."""
+    env = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
+    run_episode(env, floored(env, 32, gamma1=1e-12, gamma2=1e-12, a1=1e-9, a2=1e-9), seed=2)
+    instants = transmission_instants(env.actions)
+    np.testing.assert_array_equal(np.diff(instants), 32)
+
+
+def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions():
+    """Always choosing "paper x4, floor 48" transmits at the decision instant and then exactly
+    where the stand-alone floored rule does (through compiled intervals)."""
+    kwargs = {"max_exponent": 8, "factors": (1.0, 4.0), "rule_floor": 48}
+    base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
+    wrapper = SelfTriggeredWrapper(base, **kwargs)
+    action = wrapper.decisions.action("paper x4, floor 48")
+    wrapper.reset(seed=2)
+    lengths, done = [], False
+    while not done:
+        _, _, terminated, truncated, info = wrapper.step(action)
+        lengths.append(info["elapsed_steps"])
+        done = terminated or truncated
+    reference = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
+    run_episode(reference, ObservationLog(floored(reference, 48, **GAMMAS), [], first=True), 2)
+    np.testing.assert_array_equal(np.array(base.actions), np.array(reference.actions))
+    assert min(lengths[:-1]) >= 48 and len(set(lengths)) > 1
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"rule_floor": 0}, "rule_floor must be an integer"),
+        ({"rule_floor": 2.5}, "rule_floor must be an integer"),
+        ({"rule_floor": 64, "max_exponent": 5}, r"rule_floor \(64\) must be at most"),
+        ({"rule_floor": 8, "sampling_period_s": None}, "sampling_period_s"),
+    ],
+)
+def test_a_decision_set_refuses_a_bad_floor(kwargs, message):
+    arguments = {"sampling_period_s": SAMPLING_PERIOD_S, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        DecisionSet(ORBIT, **arguments)
+
+
+def test_the_floor_names_its_actions_and_bad_floors_name_themselves():
+    decisions = DecisionSet(
+        ORBIT, factors=(4.0,), rule_floor=64, sampling_period_s=SAMPLING_PERIOD_S
+    )
+    assert decisions.label(decisions.n_holds) == "paper x4, floor 64"
+    env = gym.make(ORBIT, horizon_s=0.05)
+    with pytest.raises(ValueError, match="floor_s"):
+        floored_trigger_class(OrbitAttitudeTrigger)(
+            env.observation_space, env.action_space, env.unwrapped.observation_names, floor_s=0.0
+        )
+
+
+class ObservationLog:
+    """A policy that keeps every observation it is asked about; with ``first`` it transmits at
+    the episode's first instant too (as a decision instant does)."""
+
+    def __init__(self, trigger, observations: list, first: bool = False) -> None:
+        self.trigger = trigger
+        self.observations = observations
+        self.first = first
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        self.observations.append(np.asarray(observation).copy())
+        action, state = self.trigger.predict(observation, state, episode_start, deterministic)
+        if self.first and len(self.observations) == 1:
+            action = np.ones_like(action)
+        return action, state
