@@ -11,6 +11,8 @@ its scenarios at once in the native vector env) and on the paper scenario:
 
 * the paper's trigger over a sweep of its threshold (:data:`PAPER_SWEEPS`: Ψ for 002, γ1 and
   γ2 for 000, c for 001, α for 003, Π for 004), the paper's own value included;
+* on ids with another event rule (:data:`RULE_SWEEPS`: 004's error-time rule), that rule over
+  a sweep of its threshold, as a curve of its own;
 * periodic transmission every ``k`` sampling instants (:func:`periodic_sweep`), wide enough
   to reach periods at which the clock fails;
 * each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
@@ -25,9 +27,9 @@ non-dominated points joined, with interval bars on both axes, dominated points f
 with failures crossed, and the paper scenario in a second panel.
 
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
-``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper and periodic curves of
-an earlier run (same closed loop, kwargs and scenario set: the PettingZoo cluster may reuse
-its central form's) and runs only the models.
+``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper, periodic (and other
+rule) curves of an earlier run (same closed loop, kwargs and scenario set: the PettingZoo cluster
+may reuse its central form's) and runs only the models and the curves it lacks.
 """
 
 from __future__ import annotations
@@ -50,7 +52,7 @@ from baselines.evaluate import evaluate
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.protocol import DEFAULT_SET_SIZE
-from etsc_envs.triggers import PAPER_THRESHOLDS
+from etsc_envs.triggers import ERROR_TIME_THRESHOLDS, PAPER_THRESHOLDS
 
 SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
 """Multiples of the paper's threshold swept where the threshold is a free positive number."""
@@ -82,6 +84,19 @@ PAPER_SWEEPS = {
     "etsc/InnerFormation-v0": lambda: _scaled("etsc/InnerFormation-v0"),
 }
 """Id → the paper-trigger arguments of each point (the paper's own values among them)."""
+
+RULE_SWEEPS = {
+    "error_time": {
+        "etsc/InnerFormation-v0": lambda: [
+            {
+                name: scale * value
+                for name, value in ERROR_TIME_THRESHOLDS["etsc/InnerFormation-v0"]().items()
+            }
+            for scale in (0.5, 1.0, 2.0, 4.0, 8.0, 16.0)
+        ],
+    },
+}
+"""Policy name (``--policy``) → id → the arguments of each point of that rule's curve."""
 
 PERIODIC_EVERY = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000)
 """Sampling instants between periodic transmissions."""
@@ -186,6 +201,10 @@ def pareto(
         }
     else:
         curves = {name: reuse["curves"][name] for name in ("paper", "periodic")}
+    for name, sweeps in RULE_SWEEPS.items():
+        if env_id in sweeps:
+            earlier = None if reuse is None else reuse["curves"].get(name)
+            curves[name] = earlier or [point(name, args) for args in sweeps[env_id]()]
     curves["learned"] = [
         {**point(f"sb3:{path}", {}), "method": method}
         for path, method in zip(models, methods, strict=True)
@@ -216,15 +235,17 @@ LEARNED = "learned"
 STYLES = {
     "paper": ("o", "-", "C0", "paper trigger (threshold sweep)"),
     "periodic": ("s", "--", "C1", "periodic (clock)"),
+    "error_time": ("P", "-.", "C8", "error-time rule (threshold sweep)"),
 }
 LEARNED_STYLES = [("*", ":", "C3"), ("D", ":", "C2"), ("^", ":", "C4"), ("v", ":", "C5")]
 """Marker, line and colour of each learned method in turn."""
 
 
 def series(result: dict[str, Any]) -> list[tuple[tuple[str, str, str, str], list[dict]]]:
-    """The curves to draw: the paper sweep, the periodic sweep, then one per learned method
-    (in order of appearance), each with its (marker, line, colour, label)."""
-    drawn = [(STYLES[name], result["curves"][name]) for name in STYLES]
+    """The curves to draw: the paper sweep, the periodic sweep, another rule's sweep where the
+    result has one, then one per learned method (in order of appearance), each with its
+    (marker, line, colour, label)."""
+    drawn = [(STYLES[name], result["curves"][name]) for name in STYLES if name in result["curves"]]
     learned = result["curves"].get("learned", [])
     methods = list(dict.fromkeys(point.get("method", LEARNED) for point in learned))
     for index, method in enumerate(methods):

@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.pareto import PAPER_SWEEPS, main, non_dominated, periodic_sweep
+from agents.pareto import PAPER_SWEEPS, RULE_SWEEPS, main, non_dominated, periodic_sweep
 from etsc_envs.triggers.attitude_tracking import PAPER_PSI
 
 
@@ -37,6 +37,23 @@ def test_pareto_writes_the_curves_with_intervals_and_the_paper_scenario(tmp_path
         assert low <= point["mean_cost"]["mean"] <= high
     paper_counts = [point["transmissions"]["mean"] for point in curves["paper"]]
     assert paper_counts == sorted(paper_counts, reverse=True), "a higher Ψ transmits less"
+
+
+def test_an_id_with_an_error_time_rule_gets_its_curve_and_reuse_keeps_it(tmp_path: Path) -> None:
+    argv = ["etsc/InnerFormation-v0", "--env-arg", "horizon_s=1.0", "--set-size", "2"]
+    first = tmp_path / "first"
+    assert main([*argv, "--out", str(first)]) == 0
+    result = json.loads((first / "pareto.json").read_text(encoding="utf-8"))
+    curve = result["curves"]["error_time"]
+    assert [point["args"] for point in curve] == RULE_SWEEPS["error_time"][
+        "etsc/InnerFormation-v0"
+    ]()
+    counts = [point["transmissions"]["mean"] for point in curve]
+    assert counts == sorted(counts, reverse=True) and counts[0] > counts[-1], "a larger A waits"
+    second = tmp_path / "second"
+    assert main([*argv, "--out", str(second), "--reuse", str(first / "pareto.json")]) == 0
+    again = json.loads((second / "pareto.json").read_text(encoding="utf-8"))
+    assert again["curves"]["error_time"] == curve
 
 
 def test_the_front_keeps_only_non_dominated_points() -> None:
