@@ -161,10 +161,11 @@ class DecisionSet:
             )
         if self.shield_multiple is None:
             return
-        if self.rule != "paper":
+        if self.rule != "paper" or self.rule_floor is not None:
             raise ValueError(
-                f"shield_multiple: the shield bounds the paper rule's factors only; a set with "
-                f"rule {self.rule!r} must have shield_multiple null"
+                f"shield_multiple: the shield bounds the paper rule's factors, not a floor's "
+                f"holds or another rule; a set with rule {self.rule!r} and rule_floor "
+                f"{self.rule_floor!r} must have shield_multiple null"
             )
         if self.env_id not in PAPER_SHIELDS:
             raise ValueError(

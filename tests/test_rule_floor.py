@@ -96,12 +96,13 @@ def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions():
         ({"rule_floor": 2.5}, "rule_floor must be an integer"),
         ({"rule_floor": 64, "max_exponent": 5}, r"rule_floor \(64\) must be at most"),
         ({"rule_floor": 8, "sampling_period_s": None}, "sampling_period_s"),
+        ({"env_id": FORMATION, "rule_floor": 8, "shield_multiple": 2.0}, "shield_multiple"),
     ],
 )
 def test_a_decision_set_refuses_a_bad_floor(kwargs, message):
-    arguments = {"sampling_period_s": SAMPLING_PERIOD_S, **kwargs}
+    arguments = {"env_id": ORBIT, "sampling_period_s": SAMPLING_PERIOD_S, **kwargs}
     with pytest.raises(ValueError, match=message):
-        DecisionSet(ORBIT, **arguments)
+        DecisionSet(**arguments)
 
 
 def test_the_floor_names_its_actions_and_bad_floors_name_themselves():
