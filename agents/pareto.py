@@ -58,11 +58,13 @@ SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
 """Multiples of the paper's threshold swept where the threshold is a free positive number."""
 
 
-def _scaled(env_id: str, scales: tuple[float, ...] = SCALES) -> list[dict[str, float]]:
-    """The paper trigger's threshold keywords of ``env_id`` (:data:`PAPER_THRESHOLDS`) at each
-    multiple of ``scales`` of the paper's values."""
-    paper_values = PAPER_THRESHOLDS[env_id]()
-    return [{name: scale * value for name, value in paper_values.items()} for scale in scales]
+def _scaled(
+    env_id: str, scales: tuple[float, ...] = SCALES, thresholds: dict = PAPER_THRESHOLDS
+) -> list[dict[str, float]]:
+    """The threshold keywords of ``env_id``'s trigger (``thresholds``, by default the paper's,
+    :data:`PAPER_THRESHOLDS`) at each multiple of ``scales`` of their default values."""
+    values = thresholds[env_id]()
+    return [{name: scale * value for name, value in values.items()} for scale in scales]
 
 
 def _cluster_sweep() -> list[dict[str, float]]:
@@ -87,13 +89,9 @@ PAPER_SWEEPS = {
 
 RULE_SWEEPS = {
     "error_time": {
-        "etsc/InnerFormation-v0": lambda: [
-            {
-                name: scale * value
-                for name, value in ERROR_TIME_THRESHOLDS["etsc/InnerFormation-v0"]().items()
-            }
-            for scale in (0.5, 1.0, 2.0, 4.0, 8.0, 16.0)
-        ],
+        "etsc/InnerFormation-v0": lambda: _scaled(
+            "etsc/InnerFormation-v0", (0.5, 1.0, 2.0, 4.0, 8.0, 16.0), ERROR_TIME_THRESHOLDS
+        ),
     },
 }
 """Policy name (``--policy``) → id → the arguments of each point of that rule's curve."""

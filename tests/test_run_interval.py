@@ -14,7 +14,7 @@ import pytest
 
 from baselines.self_triggered import scaled_rule_trigger
 from etsc_envs import ENV_IDS
-from etsc_envs.triggers import PAPER_THRESHOLDS, PAPER_TRIGGERS, PeriodicPolicy
+from etsc_envs.triggers import PAPER_TRIGGERS, PeriodicPolicy
 
 SEED = 5
 HORIZONS_S = {
@@ -156,12 +156,8 @@ def test_an_interval_before_reset_asks_for_one():
 
 def paper_trigger(env: gym.Env, factor: float = 1.0):
     """The env's paper trigger with its threshold keywords scaled by ``factor``."""
-    env_id = env.spec.id
-    scaled = {name: factor * value for name, value in PAPER_THRESHOLDS[env_id]().items()}
-    unwrapped = env.unwrapped
-    return PAPER_TRIGGERS[env_id](
-        env.observation_space, env.action_space, unwrapped.observation_names, **scaled
-    )
+    names = env.unwrapped.observation_names
+    return scaled_rule_trigger(env.spec.id, factor, env.observation_space, env.action_space, names)
 
 
 RULE_HORIZONS_S = {

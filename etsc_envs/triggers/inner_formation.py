@@ -3,6 +3,8 @@ error-time rule on the same sampling errors (a reference trigger beside the pape
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import gymnasium as gym
 import numpy as np
 
@@ -21,6 +23,28 @@ PAPER_SHIELD_MULTIPLE = 2.0
 def default_thresholds() -> np.ndarray:
     """Π_i sized by condition (7) for the paper's parameters (equal shares of the bound (A9))."""
     return equal_share_thresholds(InnerFormationParams())
+
+
+def axis_thresholds(
+    default: Callable[[], np.ndarray],
+    name: str,
+    common: float | None,
+    per_axis: tuple[float | None, float | None, float | None],
+    unit: str,
+) -> np.ndarray:
+    """The three per-axis thresholds of a trigger: ``common`` on every axis (``default()`` if
+    ``None``), each overridden by its entry of ``per_axis`` where given; ``ValueError`` naming
+    ``name``, ``name1``..``name3`` unless all are finite and > 0 (in ``unit``)."""
+    thresholds = default() if common is None else np.full(3, float(common))
+    for axis, value in enumerate(per_axis):
+        if value is not None:
+            thresholds[axis] = float(value)
+    if not np.all(np.isfinite(thresholds)) or np.any(thresholds <= 0.0):
+        raise ValueError(
+            f"{name}, {name}1, {name}2, {name}3 must be finite numbers > 0 ({unit}), "
+            f"got {thresholds}"
+        )
+    return thresholds
 
 
 @jit
@@ -50,12 +74,7 @@ class InnerFormationTrigger(RuleTrigger):
         pi2: float | None = None,
         pi3: float | None = None,
     ) -> None:
-        thresholds = default_thresholds() if pi is None else np.full(3, float(pi))
-        for axis, value in enumerate((pi1, pi2, pi3)):
-            if value is not None:
-                thresholds[axis] = float(value)
-        if not np.all(np.isfinite(thresholds)) or np.any(thresholds <= 0.0):
-            raise ValueError(f"pi, pi1, pi2, pi3 must be finite numbers > 0 (m), got {thresholds}")
+        thresholds = axis_thresholds(default_thresholds, "pi", pi, (pi1, pi2, pi3), "m")
         self.thresholds = thresholds
         super().__init__(
             observation_space,
@@ -120,14 +139,9 @@ class InnerFormationErrorTimeTrigger(RuleTrigger):
         area2: float | None = None,
         area3: float | None = None,
     ) -> None:
-        thresholds = default_error_time_thresholds() if area is None else np.full(3, float(area))
-        for axis, value in enumerate((area1, area2, area3)):
-            if value is not None:
-                thresholds[axis] = float(value)
-        if not np.all(np.isfinite(thresholds)) or np.any(thresholds <= 0.0):
-            raise ValueError(
-                f"area, area1, area2, area3 must be finite numbers > 0 (m·s), got {thresholds}"
-            )
+        thresholds = axis_thresholds(
+            default_error_time_thresholds, "area", area, (area1, area2, area3), "m·s"
+        )
         self.thresholds = thresholds
         names = [f"sampling_error_m_{a}" for a in AXES] + [
             f"time_since_transmission_s_{axis}" for axis in range(3)
