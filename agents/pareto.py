@@ -2,6 +2,7 @@
 under the test protocol.
 
     python -m agents.pareto ENV_ID [--model PATH ...] [--sweep RESULTS_DIR ...]
+                                   [--judged RESULTS_DIR ...]
                                    [--scenarios test|validation] [--set-size K]
                                    [--env-arg k=v ...] [--out DIR]
                                    [--reuse PARETO_JSON]
@@ -19,7 +20,12 @@ its scenarios at once in the native vector env) and on the paper scenario:
   typically one per transmission penalty λ, and the model of every finished trial of each
   ``--sweep`` (the results folder of ``python -m agents.sweep``: a front in one option). The
   ``--model`` points form one method, ``learned``; each sweep is a method of its own, named
-  after its folder, and drawn as its own curve.
+  after its folder, and drawn as its own curve;
+* each model already judged by ``python -m agents.results`` in a ``--judged`` folder (every
+  ``results.json`` under it, a sweep's groups included): its point is read from the
+  judgement's records on the same scenario set instead of being run again, and the folder is
+  a method of its own; a judgement without the paper scenario leaves the point out of the
+  paper-scenario panel.
 
 A point records the set's aggregates (mean ``mean_cost`` and transmissions with 95 % bootstrap
 intervals, failures) and the paper scenario's episode. The plot shows each curve's
@@ -148,6 +154,48 @@ def run_point(
     }
 
 
+def judged_points(
+    folder: Path, env_id: str, env_kwargs: dict[str, Any], scenarios: str, set_size: int
+) -> list[dict[str, Any]]:
+    """The learned points of every model judged by :mod:`agents.results` under ``folder``
+    (each ``results.json``, in path order), read from its records on ``scenarios`` (and on
+    the paper scenario where it was judged there), with ``folder``'s name as their method.
+    ``ValueError`` naming ``--judged`` if a judgement is of another id, env kwargs or scenario
+    set, or if the folder holds none."""
+    files = sorted(Path(folder).rglob("results.json"))
+    if not files:
+        raise ValueError(f"--judged: no results.json of agents.results under {str(folder)!r}")
+    points = []
+    for path in files:
+        judged = json.loads(path.read_text(encoding="utf-8"))
+        on_set = judged.get("sets", {}).get(scenarios)
+        identity = (judged.get("env"), judged.get("env_args"))
+        size = None if on_set is None else on_set["scenarios"]["size"]
+        if identity != (env_id, env_kwargs) or size != set_size:
+            raise ValueError(
+                f"--judged: {path} judges (env, env_args, {scenarios} set size) = "
+                f"{(*identity, size)}, not {(env_id, env_kwargs, set_size)}"
+            )
+        on_paper = judged["sets"].get("paper")
+        for index, row in enumerate(on_set["models"]):
+            aggregates = row["learned"]["aggregates"]
+            paper_row = None if on_paper is None else on_paper["models"][index]
+            points.append(
+                {
+                    "policy": f"sb3:{row['model']}",
+                    "args": {},
+                    "mean_cost": aggregates["mean_cost"],
+                    "transmissions": aggregates["transmissions"],
+                    "failures": aggregates["failure"]["count"],
+                    "paper_scenario": None
+                    if paper_row is None
+                    else episode_summary(paper_row["learned"]["episodes"][0]),
+                    "method": Path(folder).name,
+                }
+            )
+    return points
+
+
 def closed_loop_id(env_id: str) -> str:
     """The Gymnasium id of the closed loop ``env_id`` runs: a PettingZoo id's agents share the
     loop of its central form, so the paper and periodic points of the two ids are the same
@@ -163,11 +211,13 @@ def pareto(
     set_size: int = DEFAULT_SET_SIZE,
     reuse: dict[str, Any] | None = None,
     methods: list[str] | None = None,
+    judged: list[Path] | None = None,
 ) -> dict[str, Any]:
     """The three curves of the module docstring for ``env_id``; with ``reuse`` (an earlier
     result of the same id, kwargs and scenario set), its paper and periodic curves are kept and
     only the models run. ``methods`` names each model's method (the plot draws each method as
-    its own curve; default one method, ``learned``)."""
+    its own curve; default one method, ``learned``); the models judged under each folder of
+    ``judged`` join the learned points without running (:func:`judged_points`)."""
     methods = list(methods) if methods is not None else [LEARNED] * len(models)
     if len(methods) != len(models):
         raise ValueError(f"methods: one per model ({len(models)}), got {len(methods)}")
@@ -188,6 +238,11 @@ def pareto(
             )
 
     require_policies(env_id, env_kwargs, [f"sb3:{path}" for path in models])
+    read = [
+        point
+        for folder in judged or []
+        for point in judged_points(folder, env_id, env_kwargs, scenarios, set_size)
+    ]
 
     def point(spec: str, args: dict[str, Any]) -> dict[str, Any]:
         return run_point(env_id, spec, args, env_kwargs, scenarios, set_size)
@@ -206,7 +261,7 @@ def pareto(
     curves["learned"] = [
         {**point(f"sb3:{path}", {}), "method": method}
         for path, method in zip(models, methods, strict=True)
-    ]
+    ] + read
     return {
         "env": env_id,
         "env_kwargs": env_kwargs,
@@ -299,7 +354,11 @@ def _bars(summaries: list[dict[str, Any]]) -> list[list[float]]:
 def _draw_paper_scenario(axes: plt.Axes, result: dict[str, Any]) -> None:
     for (marker, line, color, label), points in reversed(series(result)):
         learned = label not in {style[3] for style in STYLES.values()}
-        scenario = [p["paper_scenario"] for p in points if p["paper_scenario"]["transmissions"]]
+        scenario = [
+            p["paper_scenario"]
+            for p in points
+            if p["paper_scenario"] is not None and p["paper_scenario"]["transmissions"]
+        ]
         finished = [p for p in scenario if p["failure"] is None]
         front = non_dominated(finished, lambda p: p["mean_cost"], lambda p: p["transmissions"])
         axes.plot(
@@ -354,7 +413,7 @@ def plot(result: dict[str, Any], path: Path) -> None:
     _draw_paper_scenario(right, result)
     points = [p for curve in result["curves"].values() for p in curve]
     _log_axes(left, [p["mean_cost"]["mean"] for p in points])
-    _log_axes(right, [p["paper_scenario"]["mean_cost"] for p in points])
+    _log_axes(right, [p["paper_scenario"]["mean_cost"] for p in points if p["paper_scenario"]])
     left.set_ylabel("mean_cost (accuracy cost per step)")
     left.set_title(
         f"{result['scenarios']} set, {result['set_size']} scenarios: mean, 95 % intervals",
@@ -391,6 +450,15 @@ def main(argv: list[str] | None = None) -> int:
         metavar="RESULTS_DIR",
         help="add the model of every finished trial of a sweep (agents.sweep; repeatable)",
     )
+    parser.add_argument(
+        "--judged",
+        action="append",
+        default=[],
+        type=Path,
+        metavar="RESULTS_DIR",
+        help="add the models judged by agents.results under a folder, read from their "
+        "records without running them again (repeatable)",
+    )
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
     parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
     parser.add_argument(
@@ -412,7 +480,14 @@ def main(argv: list[str] | None = None) -> int:
             models += found
             methods += [Path(results_dir).name] * len(found)
         result = pareto(
-            args.env_id, models, env_kwargs, args.scenarios, args.set_size, reuse, methods
+            args.env_id,
+            models,
+            env_kwargs,
+            args.scenarios,
+            args.set_size,
+            reuse,
+            methods,
+            args.judged,
         )
     except (ValueError, TypeError, OSError, gym.error.Error) as error:
         parser.error(str(error))

@@ -14,9 +14,11 @@ import etsc_envs
 from baselines.episodes import run_episode, run_parallel_episode, to_jsonable
 from baselines.policies import load_sb3
 from baselines.self_triggered import decision_set_path, load_self_triggered
+from etsc_envs.core.compiled_loop import always_accepts
 from etsc_envs.core.files import atomic_write_text
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.triggers import RULE_FAMILIES, AlwaysPolicy, PeriodicPolicy
-from etsc_envs.triggers.base import HeartbeatPolicy
+from etsc_envs.triggers.base import ClockTrigger, HeartbeatPolicy
 
 POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP"
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
@@ -65,6 +67,7 @@ def make_policy(spec: str, env: gym.Env, policy_args: dict[str, Any], env_id: st
         lambda: env.unwrapped.observation_names,
         policy_args,
         env_id,
+        lambda: env.unwrapped,
     )
 
 
@@ -88,6 +91,7 @@ def make_agent_policy(spec: str, env: Any, policy_args: dict[str, Any], env_id: 
         lambda: env.unwrapped.agent_observation_names,
         policy_args,
         env_id,
+        lambda: env.unwrapped.loop,
     )
 
 
@@ -161,12 +165,27 @@ def _policy_for(
     observation_names: Callable[[], tuple[str, ...]],
     policy_args: dict[str, Any],
     env_id: str,
+    loop: Callable[[], EventTriggeredEnv],
 ) -> Any:
-    """The policy named by ``spec`` for the given spaces (names are read only if needed)."""
+    """The policy named by ``spec`` for the given spaces (the names and the env's ``loop`` are
+    read only if needed). ``periodic`` is :class:`ClockTrigger` — :class:`PeriodicPolicy`'s
+    decisions as a rule that the compiled loop runs (:mod:`baselines.batch`) — where the
+    receiver takes every transmission; where it may refuse one (paper 003's burst in
+    progress), the time since transmission no longer counts the clock's instants, and
+    ``periodic`` is the counter-based :class:`PeriodicPolicy`."""
     if spec == "always":
         return AlwaysPolicy(observation_space, action_space, **policy_args)
     if spec == "periodic":
-        return PeriodicPolicy(observation_space, action_space, **policy_args)
+        environment = loop()
+        if environment.kernels.accepts is not always_accepts:
+            return PeriodicPolicy(observation_space, action_space, **policy_args)
+        return ClockTrigger(
+            observation_space,
+            action_space,
+            observation_names(),
+            sampling_period_s=environment.sampling_period_s,
+            **policy_args,
+        )
     if spec in RULE_FAMILIES:
         triggers = RULE_FAMILIES[spec][0]
         if env_id not in triggers:

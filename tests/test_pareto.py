@@ -119,3 +119,32 @@ def test_costs_within_one_decade_still_get_labelled_ticks() -> None:
     labels = [tick.get_text() for tick in axes.get_yticklabels(minor=True) if tick.get_text()]
     plt.close(figure)
     assert labels, "a cost axis inside one decade needs labelled minor ticks"
+
+
+def test_judged_models_are_read_from_their_judgement_as_a_run_gives_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A model judged by agents.results gives, through ``--judged``, the point that running
+    it gives (set aggregates and paper-scenario episode), under its folder's method; a
+    judgement of another set size is refused naming ``--judged``."""
+    from agents.results import main as judge
+
+    model = str(Path(__file__).resolve().parents[1] / "models" / "AttitudeTracking-v0_ppo.zip")
+    argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.3", "--set-size", "3"]
+    judged = tmp_path / "front" / "transmission_penalty=1"
+    assert judge([*argv, "--model", model, "--out", str(judged)]) == 0
+    run, read = tmp_path / "run", tmp_path / "read"
+    assert main([*argv, "--model", model, "--out", str(run)]) == 0
+    reuse = ["--reuse", str(run / "pareto.json")]
+    assert main([*argv, "--judged", str(tmp_path / "front"), "--out", str(read), *reuse]) == 0
+    ran = json.loads((run / "pareto.json").read_text(encoding="utf-8"))["curves"]["learned"]
+    got = json.loads((read / "pareto.json").read_text(encoding="utf-8"))["curves"]["learned"]
+    assert [point["method"] for point in got] == ["front"]
+    for key in ("policy", "mean_cost", "transmissions", "failures", "paper_scenario"):
+        assert got[0][key] == ran[0][key], key
+    assert (read / "pareto.png").stat().st_size > 0
+    other_size = [*argv[:-1], "2", "--judged", str(tmp_path / "front")]
+    with pytest.raises(SystemExit) as refused:
+        main([*other_size, "--out", str(tmp_path / "refused")])
+    assert refused.value.code == 2
+    assert "--judged:" in capsys.readouterr().err

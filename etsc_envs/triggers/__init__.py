@@ -1,6 +1,6 @@
 """Reference trigger policies: the papers' own triggering rules (one module per problem, looked
 up by environment id in :data:`PAPER_TRIGGERS`), the time-triggered references
-:class:`AlwaysPolicy` and :class:`PeriodicPolicy`, and other event rules on the same signals
+:class:`AlwaysPolicy` and :class:`PeriodicPolicy` (compiled: :class:`ClockTrigger`), and other event rules on the same signals
 (:data:`ERROR_TIME_TRIGGERS`); :data:`RULE_FAMILIES` names each family of rules.
 
 Every policy answers like a Stable-Baselines3 model, ``predict(obs, state=None,
@@ -21,7 +21,7 @@ from collections.abc import Callable
 
 from etsc_envs.triggers.asteroid import PAPER_ALPHA, AsteroidOrbitKeepingTrigger, AsteroidShield
 from etsc_envs.triggers.attitude_tracking import PAPER_PSI, AttitudeTrackingTrigger
-from etsc_envs.triggers.base import AlwaysPolicy, PeriodicPolicy, TriggerPolicy
+from etsc_envs.triggers.base import AlwaysPolicy, ClockTrigger, PeriodicPolicy, TriggerPolicy
 from etsc_envs.triggers.cluster import PAPER_C, ClusterContainmentTrigger
 from etsc_envs.triggers.inner_formation import (
     InnerFormationErrorTimeTrigger,
@@ -104,6 +104,7 @@ __all__ = [
     "AsteroidOrbitKeepingTrigger",
     "AsteroidShield",
     "AttitudeTrackingTrigger",
+    "ClockTrigger",
     "ClusterContainmentTrigger",
     "InnerFormationErrorTimeTrigger",
     "InnerFormationTrigger",

@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 import gymnasium as gym
 import numpy as np
 
-from etsc_envs.core.jit import closure_jit
+from etsc_envs.core.jit import closure_jit, jit
 
 
 def transmit_bits(action_space: gym.Space) -> int | None:
@@ -306,3 +306,62 @@ def floor_seconds(floor: int, sampling_period_s: float) -> float:
     instant k may transmit again from instant k + ``floor`` on (its time since transmission
     there is ``floor`` periods; half a period below, so float32 observations compare safely)."""
     return (int(floor) - 0.5) * float(sampling_period_s)
+
+
+@jit
+def clock_rule(observation, indices, parameters, out):
+    """Periodic transmission on one observation: channel c (its time since transmission at
+    ``indices[c]``) transmits at the episode's first instant, where that time is 0 (below
+    ``parameters[1]``, half a period), and once it reaches ``every`` periods (at least
+    ``parameters[0]``, ``every - 1/2`` periods)."""
+    for channel in range(out.shape[0]):
+        elapsed = float(observation[indices[channel]])
+        out[channel] = 1 if elapsed < parameters[1] or elapsed >= parameters[0] else 0
+
+
+class ClockTrigger(RuleTrigger):
+    """Periodic transmission every ``every`` sampling instants as a stateless rule on the
+    channels' times since transmission, so that the compiled loop runs it like a paper's rule.
+
+    Its decisions are :class:`PeriodicPolicy`'s (instants 0, K, 2K, ... of every episode on
+    every channel): a channel's time since transmission is 0 only at the episode's first
+    instant, and reaches K periods exactly K instants after each transmission
+    (``tests/test_baselines.py`` checks the two instant for instant on every id).
+
+    Args:
+        every: K, the period in sampling instants (an integer >= 1).
+        sampling_period_s: the env's sampling period (s).
+    """
+
+    def __init__(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        observation_names: tuple[str, ...],
+        every: int = 1,
+        sampling_period_s: float = 1.0,
+    ) -> None:
+        if isinstance(every, bool) or int(every) != every or every < 1:
+            raise ValueError(f"every must be an integer >= 1 (sampling instants), got {every!r}")
+        period = float(sampling_period_s)
+        if not np.isfinite(period) or period <= 0.0:
+            raise ValueError(
+                f"sampling_period_s must be a finite number > 0 (s), got {sampling_period_s!r}"
+            )
+        self.every = int(every)
+        channels = 1 if transmit_bits(action_space) is None else transmit_bits(action_space)
+        times = time_since_transmission_indices(observation_names)
+        if len(times) != channels:
+            raise ValueError(
+                f"observation_names must hold one {TIME_SINCE_TRANSMISSION}* per channel "
+                f"({channels}), got {len(times)}"
+            )
+        super().__init__(
+            observation_space,
+            action_space,
+            indices=times,
+            parameters=[floor_seconds(self.every, period), 0.5 * period],
+            keywords={"every": self.every, "sampling_period_s": period},
+        )
+
+    rule = staticmethod(clock_rule)
