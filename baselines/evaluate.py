@@ -65,8 +65,9 @@ def evaluate(
             (:func:`baselines.batch.run_batch_in_processes`); ``None`` takes
             :func:`baselines.batch.process_count`'s, 1 runs it in this process.
 
-    Several episodes without plots run at once in the id's native vector env
-    (:func:`baselines.batch.run_batch`); the records equal the one-by-one runs'.
+    Episodes without plots run at once in the id's native vector env
+    (:func:`baselines.batch.run_batch`), a single one too (the paper scenario), so that a rule
+    or a clock runs inside the compiled loop; the records equal the one-by-one runs'.
 
     Returns ``{"env", "policy", "policy_args", "env_args", "scenarios", "episodes": [...],
     "mean": {...}, "aggregates": {...}}``. For a PettingZoo id
@@ -84,10 +85,10 @@ def evaluate(
         seeds, described = [seed + episode for episode in range(episodes)], None
     setup = episode_setup(env_id, env_args)
     trigger = setup.make_policy(policy, policy_args)
-    if len(seeds) > 1 and plot_dir is None:
+    if plot_dir is None:
         setup.env.close()
         processes = process_count(len(seeds)) if processes is None else processes
-        description = f"{policy} on {len(seeds)} scenarios"
+        description = f"{policy} on {len(seeds)} scenario" + ("s" if len(seeds) > 1 else "")
         if processes > 1:
             records = run_batch_in_processes(
                 env_id,

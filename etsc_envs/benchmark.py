@@ -2,7 +2,8 @@
 
     python -m etsc_envs.benchmark [--steps N] [--repeats R] [--env ID ...]
                                   [--num-envs N ...] [--reproductions [NNN ...]]
-                                  [--protocol [K]] [--json PATH|-]
+                                  [--protocol [K]] [--protocol-policy SPEC]
+                                  [--protocol-arg K=V ...] [--json PATH|-]
 
 Every figure is the median of ``R`` timed runs (at least 5 by default) after an untimed warm-up
 run that compiles and fills the caches, with the minimum and maximum beside it. Actions are
@@ -21,11 +22,13 @@ that ends is reset inside the timed loop (its cost is part of the figure).
 * ``--protocol [K]``: the wall time of ``python -m baselines.evaluate ID --policy paper
   --scenarios test --set-size K`` (default K = 64) for every chosen id, as a user runs it;
   the test protocol asks for at most 2 minutes per id (``docs/protocol.md``).
+  ``--protocol-policy SPEC`` times another ``--policy`` of ``baselines.evaluate`` instead
+  (``periodic``, ``sb3:PATH``, ...), with its ``--protocol-arg K=V`` as ``--policy-arg``.
 
 The JSON is ``{"machine": ..., "envs": {id: {"single_steps_per_s": {"median", "min", "max",
 "runs"}, "vector_env_steps_per_s": {"1": {...}, "16": {...}, "256": {...}}}}, "reproductions":
-{paper: {"wall_time_s": {...}}}, "protocol": {"set_size": K, "ids": {id: {"wall_time_s":
-{...}}}}}``.
+{paper: {"wall_time_s": {...}}}, "protocol": {"set_size": K, "policy": SPEC, "policy_args":
+[K=V, ...], "ids": {id: {"wall_time_s": {...}}}}}``.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ import statistics
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -167,16 +170,20 @@ def benchmark_reproductions(papers: list[str], repeats: int) -> dict[str, Any]:
     return results
 
 
-def time_test_set_evaluation(env_id: str, set_size: int) -> float:
-    """Wall-clock seconds of the paper trigger on ``set_size`` test scenarios of ``env_id``
-    (``python -m baselines.evaluate`` in a fresh process)."""
+def time_test_set_evaluation(
+    env_id: str, set_size: int, policy: str = "paper", policy_args: Sequence[str] = ()
+) -> float:
+    """Wall-clock seconds of ``policy`` (a ``--policy`` of ``baselines.evaluate``, with its
+    ``K=V`` ``policy_args``) on ``set_size`` test scenarios of ``env_id`` (``python -m
+    baselines.evaluate`` in a fresh process)."""
     command = [
         sys.executable,
         "-m",
         "baselines.evaluate",
         env_id,
         "--policy",
-        "paper",
+        policy,
+        *[part for pair in policy_args for part in ("--policy-arg", pair)],
         "--scenarios",
         "test",
         "--set-size",
@@ -187,15 +194,28 @@ def time_test_set_evaluation(env_id: str, set_size: int) -> float:
     return time.perf_counter() - started
 
 
-def benchmark_protocol(env_ids: list[str], set_size: int, repeats: int) -> dict[str, Any]:
+def benchmark_protocol(
+    env_ids: list[str],
+    set_size: int,
+    repeats: int,
+    policy: str = "paper",
+    policy_args: Sequence[str] = (),
+) -> dict[str, Any]:
     """Median wall time of one policy on the test set of each id, after a warm-up run of one
     scenario that compiles or loads the machine code."""
     results = {}
     for env_id in env_ids:
-        time_test_set_evaluation(env_id, 1)
-        runs = [time_test_set_evaluation(env_id, set_size) for _ in range(repeats)]
+        time_test_set_evaluation(env_id, 1, policy, policy_args)
+        runs = [
+            time_test_set_evaluation(env_id, set_size, policy, policy_args) for _ in range(repeats)
+        ]
         results[env_id] = {"wall_time_s": summary(runs)}
-    return {"set_size": set_size, "ids": results}
+    return {
+        "set_size": set_size,
+        "policy": policy,
+        "policy_args": list(policy_args),
+        "ids": results,
+    }
 
 
 def machine() -> dict[str, Any]:
@@ -225,11 +245,12 @@ def print_report(payload: dict[str, Any]) -> None:
             print(f"  agent-steps ({agents} agents)    {cell(record['agent_steps_per_s'])} /s")
         for count, figure in record.get("vector_env_steps_per_s", {}).items():
             print(f"  vector env, {count:>4} envs    {cell(figure)} env-steps/s")
-    protocol = payload.get("protocol")
-    for env_id, record in (protocol or {}).get("ids", {}).items():
+    protocol = payload.get("protocol") or {}
+    timed = " ".join([protocol.get("policy", "paper"), *protocol.get("policy_args", [])])
+    for env_id, record in protocol.get("ids", {}).items():
         figure = record["wall_time_s"]
         print(
-            f"{env_id}: paper trigger on {protocol['set_size']} test scenarios "
+            f"{env_id}: {timed} on {protocol['set_size']} test scenarios "
             f"{figure['median']:.1f} s [{figure['min']:.1f}, {figure['max']:.1f}]"
         )
     for paper, record in payload.get("reproductions", {}).items():
@@ -276,6 +297,19 @@ def build_parser() -> argparse.ArgumentParser:
         help="also time the paper trigger on K test scenarios of every chosen id (default 64)",
     )
     parser.add_argument(
+        "--protocol-policy",
+        default="paper",
+        metavar="SPEC",
+        help="the --policy of baselines.evaluate that --protocol times (default paper)",
+    )
+    parser.add_argument(
+        "--protocol-arg",
+        action="append",
+        default=[],
+        metavar="K=V",
+        help="a --policy-arg of the timed policy (repeatable)",
+    )
+    parser.add_argument(
         "--json",
         metavar="PATH|-",
         type=output_file_argument("--json"),
@@ -311,7 +345,9 @@ def main(argv: list[str] | None = None) -> int:
         payload["reproductions"] = benchmark_reproductions(papers, args.repeats)
     if args.protocol is not None:
         ids = args.env or [*ENV_IDS, *PETTINGZOO_ENV_IDS]
-        payload["protocol"] = benchmark_protocol(ids, args.protocol, args.repeats)
+        payload["protocol"] = benchmark_protocol(
+            ids, args.protocol, args.repeats, args.protocol_policy, args.protocol_arg
+        )
     if args.json == "-":
         json.dump(payload, sys.stdout, indent=2)
         sys.stdout.write("\n")
