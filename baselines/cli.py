@@ -176,6 +176,11 @@ def _policy_for(
     if spec == "always":
         return AlwaysPolicy(observation_space, action_space, **policy_args)
     if spec == "periodic":
+        if set(policy_args) - {"every"}:
+            raise ValueError(
+                f"--policy-arg: periodic takes every=K (sampling instants) only, got "
+                f"{sorted(policy_args)}"
+            )
         environment = loop()
         if environment.kernels.accepts is not always_accepts:
             return PeriodicPolicy(observation_space, action_space, **policy_args)

@@ -8,8 +8,8 @@ Checked properties (every id, Gymnasium and PettingZoo):
 * the batch path, which runs the clock inside the compiled loop, gives the records of
   :class:`PeriodicPolicy` stepped one instant at a time, a scenario that fails early included;
 * ``--policy periodic`` builds the compiled clock where the receiver takes every transmission
-  (paper 003's, which refuses one during a burst, keeps the counter); bad periods, sampling periods and
-  observation layouts are refused naming the argument.
+  (paper 003's, which refuses one during a burst, keeps the counter); bad periods, sampling
+  periods, policy arguments and observation layouts are refused naming the argument.
 """
 
 from __future__ import annotations
@@ -140,3 +140,10 @@ def test_the_clock_reads_only_the_times_since_transmission(formation: gym.Env) -
     actions, _ = clock.predict(observations)
     expected = np.array([1, 0, 0, 1, 1, 1])
     assert actions.tolist() == np.repeat(expected[:, None], 3, axis=1).tolist()
+
+
+def test_periodic_takes_only_its_period() -> None:
+    setup = episode_setup("etsc/AttitudeTracking-v0", {"horizon_s": 0.1})
+    with pytest.raises(ValueError, match="periodic takes every=K"):
+        setup.make_policy("periodic", {"every": 3, "sampling_period_s": 0.5})
+    setup.env.close()

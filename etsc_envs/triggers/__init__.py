@@ -1,7 +1,8 @@
 """Reference trigger policies: the papers' own triggering rules (one module per problem, looked
 up by environment id in :data:`PAPER_TRIGGERS`), the time-triggered references
-:class:`AlwaysPolicy` and :class:`PeriodicPolicy` (compiled: :class:`ClockTrigger`), and other event rules on the same signals
-(:data:`ERROR_TIME_TRIGGERS`); :data:`RULE_FAMILIES` names each family of rules.
+:class:`AlwaysPolicy` and :class:`PeriodicPolicy` (compiled: :class:`ClockTrigger`), and other
+event rules on the same signals (:data:`ERROR_TIME_TRIGGERS`); :data:`RULE_FAMILIES` names
+each family of rules.
 
 Every policy answers like a Stable-Baselines3 model, ``predict(obs, state=None,
 episode_start=None, deterministic=True) -> (action, state)``::
