@@ -432,8 +432,8 @@ def main(argv: list[str] | None = None) -> int:
             }
         )
         env_args = parse_assignments(args.env_arg, "--env-arg")
-        results = {
-            folder: compare(
+        for folder, models in methods.items():
+            result = compare(
                 args.env_id,
                 models,
                 env_args,
@@ -441,14 +441,11 @@ def main(argv: list[str] | None = None) -> int:
                 args.set_size,
                 progress=True,
             )
-            for folder, models in methods.items()
-        }
+            write_json(result, str(folder / "results.json"))
+            print(markdown(result))
+            print(f"wrote {folder / 'results.json'}", flush=True)
     except (ValueError, TypeError, gym.error.Error) as error:
         parser.error(str(error))
-    for folder, result in results.items():
-        write_json(result, str(folder / "results.json"))
-        print(markdown(result))
-        print(f"wrote {folder / 'results.json'}")
     return 0
 
 

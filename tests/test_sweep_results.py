@@ -119,3 +119,31 @@ def test_pareto_and_results_read_a_sweep_folder(tmp_path: Path) -> None:
     assert result["models"] == [model]
     with pytest.raises(SystemExit):
         results.main([ENV_ID, "--sweep", str(tmp_path), *short])
+
+
+def test_each_group_of_a_sweep_is_written_as_soon_as_it_is_judged(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A judgement that stops at its second group keeps the first group's results.json."""
+    trials = [
+        SweepTrial(f"transmission_penalty={value},seed=0", {}, "finished", None, tmp_path, None)
+        for value in (1, 3)
+    ]
+    monkeypatch.setattr(results, "finished_trials", lambda folder, env_id: trials)
+    judged: list[list[str]] = []
+
+    def compare(env_id: str, models: list[str], *arguments: object, **keywords: object) -> dict:
+        judged.append(models)
+        if len(judged) == 2:
+            raise ValueError("--model: the second group's model does not load")
+        return {"env": env_id, "models": models}
+
+    monkeypatch.setattr(results, "compare", compare)
+    monkeypatch.setattr(results, "markdown", lambda result: "")
+    out = tmp_path / "judged"
+    with pytest.raises(SystemExit):
+        results.main([ENV_ID, "--sweep", str(tmp_path), "--out", str(out)])
+    assert len(judged) == 2
+    first = json.loads((out / "transmission_penalty=1" / "results.json").read_text("utf-8"))
+    assert first["models"] == judged[0]
+    assert not (out / "transmission_penalty=3").exists()
