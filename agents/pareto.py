@@ -143,6 +143,17 @@ def run_point(
     on_paper = evaluate(
         env_id, policy_spec, policy_args=policy_args, env_args=env_kwargs, scenarios="paper"
     )
+    return point_of(policy_spec, policy_args, on_set, on_paper)
+
+
+def point_of(
+    policy_spec: str,
+    policy_args: dict[str, Any],
+    on_set: dict[str, Any],
+    on_paper: dict[str, Any] | None,
+) -> dict[str, Any]:
+    """A point from a policy's evaluations (``baselines.evaluate``'s results) on the scenario
+    set and on the paper scenario (``None``: not run there)."""
     aggregates = on_set["aggregates"]
     return {
         "policy": policy_spec,
@@ -150,7 +161,7 @@ def run_point(
         "mean_cost": aggregates["mean_cost"],
         "transmissions": aggregates["transmissions"],
         "failures": aggregates["failure"]["count"],
-        "paper_scenario": episode_summary(on_paper["episodes"][0]),
+        "paper_scenario": None if on_paper is None else episode_summary(on_paper["episodes"][0]),
     }
 
 
@@ -178,21 +189,9 @@ def judged_points(
             )
         on_paper = judged["sets"].get("paper")
         for index, row in enumerate(on_set["models"]):
-            aggregates = row["learned"]["aggregates"]
-            paper_row = None if on_paper is None else on_paper["models"][index]
-            points.append(
-                {
-                    "policy": f"sb3:{row['model']}",
-                    "args": {},
-                    "mean_cost": aggregates["mean_cost"],
-                    "transmissions": aggregates["transmissions"],
-                    "failures": aggregates["failure"]["count"],
-                    "paper_scenario": None
-                    if paper_row is None
-                    else episode_summary(paper_row["learned"]["episodes"][0]),
-                    "method": Path(folder).name,
-                }
-            )
+            paper_run = None if on_paper is None else on_paper["models"][index]["learned"]
+            point = point_of(f"sb3:{row['model']}", {}, row["learned"], paper_run)
+            points.append({**point, "method": Path(folder).name})
     return points
 
 
