@@ -226,13 +226,23 @@ TIME_SINCE_TRANSMISSION = "time_since_transmission_s"
 transmission (s): one per channel, in channel order."""
 
 
-def time_since_transmission_indices(observation_names: tuple[str, ...]) -> list[int]:
-    """The observation indices of the channels' times since transmission, in channel order."""
-    return [
+def time_since_transmission_indices(
+    observation_names: tuple[str, ...], n_channels: int
+) -> list[int]:
+    """The observation indices of the ``n_channels`` channels' times since transmission, in
+    channel order; ``ValueError`` naming ``observation_names`` unless there is one per
+    channel."""
+    times = [
         index
         for index, name in enumerate(observation_names)
         if name.startswith(TIME_SINCE_TRANSMISSION)
     ]
+    if len(times) != n_channels:
+        raise ValueError(
+            f"observation_names must hold one {TIME_SINCE_TRANSMISSION}* per channel "
+            f"({n_channels}), got {len(times)}"
+        )
+    return times
 
 
 @functools.cache
@@ -281,12 +291,7 @@ def floored_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]
             if not np.isfinite(floor_s) or floor_s <= 0.0:
                 raise ValueError(f"floor_s must be a finite number > 0 (s), got {floor_s!r}")
             inner = trigger_class(observation_space, action_space, observation_names, **keywords)
-            times = time_since_transmission_indices(observation_names)
-            if len(times) != inner.n_channels:
-                raise ValueError(
-                    f"observation_names must hold one {TIME_SINCE_TRANSMISSION}* per channel "
-                    f"({inner.n_channels}), got {len(times)}"
-                )
+            times = time_since_transmission_indices(observation_names, inner.n_channels)
             self.floor_s = floor_s
             self.inner = inner
             super().__init__(
@@ -350,12 +355,7 @@ class ClockTrigger(RuleTrigger):
             )
         self.every = int(every)
         channels = 1 if transmit_bits(action_space) is None else transmit_bits(action_space)
-        times = time_since_transmission_indices(observation_names)
-        if len(times) != channels:
-            raise ValueError(
-                f"observation_names must hold one {TIME_SINCE_TRANSMISSION}* per channel "
-                f"({channels}), got {len(times)}"
-            )
+        times = time_since_transmission_indices(observation_names, channels)
         super().__init__(
             observation_space,
             action_space,
