@@ -51,6 +51,13 @@ A config is a YAML mapping with these keys (the optional ones show their default
   (``"paper x0.25"``, ``"hold 64"``: :meth:`baselines.self_triggered.DecisionSet.label`;
   :func:`agents.imitation.imitate_decision`); needed with ``decisions`` and
   ``imitation_steps``, refused without ``decisions``;
+  ``imitation_decision: best`` chooses it per run instead: the decision with the highest mean
+  return on the first ``evaluation_scenarios`` validation scenarios at the run's env kwargs,
+  its transmission penalty among them (:mod:`agents.decision_selection`; recorded in
+  ``out_dir/decision_selection.json``), so that each λ of a front starts from its own
+  baseline;
+* ``imitation_candidates: null`` — with ``imitation_decision: best``, the labels it chooses
+  among (``null``: every decision of the set);
 * ``imitation_pinned_probability: null`` — with ``imitation_decision``, a probability p in
   (0, 1): after cloning, the policy's action head is set to take the cloned decision with
   probability p at every observation (:func:`agents.imitation.pin_decision`), so that
@@ -88,9 +95,11 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
+from agents.decision_selection import BEST_DECISION
 from agents.decisions import make_decision_env
 from baselines.cli import require_env_id
 from baselines.policies import require_model_fits
+from baselines.self_triggered import DecisionSet
 from etsc_envs.core.files import require_writable_folder
 from etsc_envs.protocol import require_training_seeds
 
@@ -124,6 +133,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "imitation_steps": 0,
     "imitation_epochs": 10,
     "imitation_decision": None,
+    "imitation_candidates": None,
     "imitation_pinned_probability": None,
     "decisions": None,
 }
@@ -158,6 +168,7 @@ class TrainConfig:
     imitation_steps: int
     imitation_epochs: int
     imitation_decision: str | None
+    imitation_candidates: list[str] | None
     imitation_pinned_probability: float | None
     decisions: dict[str, Any] | None
 
@@ -227,6 +238,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
         imitation_decision=values["imitation_decision"],
+        imitation_candidates=values["imitation_candidates"],
         imitation_pinned_probability=_check_pinned_probability(values),
         decisions=decisions,
     )
@@ -326,13 +338,39 @@ def _check_decisions(
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
     try:
-        if label is not None:
-            wrapper.decisions.action(label)
-    except ValueError as error:
-        raise ValueError(f"config key 'imitation_decision': {error}") from None
+        _check_labels(values, wrapper.decisions)
     finally:
         wrapper.close()
     return decisions
+
+
+def _check_labels(values: Mapping[str, Any], decisions: DecisionSet) -> None:
+    """``imitation_decision`` (a label of ``decisions`` or ``best``) and
+    ``imitation_candidates`` (null, or labels of ``decisions`` beside ``best``)."""
+    label, candidates = values["imitation_decision"], values["imitation_candidates"]
+    if candidates is not None and label != BEST_DECISION:
+        raise ValueError(
+            f"config key 'imitation_candidates' needs 'imitation_decision: {BEST_DECISION}', "
+            f"got imitation_decision={label!r}"
+        )
+    if label is None or label == BEST_DECISION:
+        if candidates is None:
+            return
+        if not isinstance(candidates, list) or not candidates:
+            raise ValueError(
+                "config key 'imitation_candidates' must be a non-empty list of decision labels "
+                f"or null, got {candidates!r}"
+            )
+        for candidate in candidates:
+            try:
+                decisions.action(str(candidate))
+            except ValueError as error:
+                raise ValueError(f"config key 'imitation_candidates': {error}") from None
+        return
+    try:
+        decisions.action(label)
+    except ValueError as error:
+        raise ValueError(f"config key 'imitation_decision': {error}") from None
 
 
 def _check_algorithm_fits_env(

@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
@@ -42,6 +43,21 @@ def set_summary(records: list[dict[str, Any]]) -> dict[str, Any]:
     }
     summary["failures"] = sum(record["failure"] is not None for record in records)
     return summary
+
+
+def deployment(
+    env_id: str, env_kwargs: dict[str, Any], decisions: DecisionSet
+) -> tuple[IntervalSchedule, gym.Space, gym.Space]:
+    """The schedule of ``decisions`` and the transmit/hold spaces a policy of them acts in on
+    ``env_id`` (one agent's, for a PettingZoo id): the arguments of
+    :class:`~baselines.self_triggered.SelfTriggeredPolicy` after its model."""
+    setup = episode_setup(env_id, env_kwargs)
+    try:
+        observation_space, action_space, names = setup.policy_spaces()
+    finally:
+        setup.env.close()
+    schedule = IntervalSchedule(decisions, observation_space, action_space, names)
+    return schedule, observation_space, action_space
 
 
 class PaperComparisonCallback(BaseCallback):
@@ -106,10 +122,9 @@ class PaperComparisonCallback(BaseCallback):
     def _on_training_start(self) -> None:
         setup = episode_setup(self.env_id, self.env_kwargs)
         paper_trigger = setup.make_policy("paper", {})
-        if self.decisions is not None:
-            *spaces, names = setup.policy_spaces()
-            self._deployment = (IntervalSchedule(self.decisions, *spaces, names), *spaces)
         setup.env.close()
+        if self.decisions is not None:
+            self._deployment = deployment(self.env_id, self.env_kwargs, self.decisions)
         self.paper = set_summary(self._run(paper_trigger))
         self._next_evaluation = self.num_timesteps + self.every
         self._started = time.perf_counter()

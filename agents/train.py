@@ -11,7 +11,9 @@ Writes to the output directory ``model.zip`` (a plain SB3 save, loadable by
 config after the command-line overrides and defaults), ``train_summary.json`` (wall time,
 timesteps, steps per second and the last episodes' returns and metrics), and as configured
 ``checkpoints/``, ``tensorboard/`` and ``evaluations.json`` (the policy against the paper's
-trigger during training). ``--resume`` continues from the newest intact checkpoint in
+trigger during training), and with ``imitation_decision: best`` ``decision_selection.json``
+(every candidate decision's validation summary and the one chosen,
+:mod:`agents.decision_selection`). ``--resume`` continues from the newest intact checkpoint in
 ``checkpoints/`` up to ``total_timesteps``, keeping the evaluation history up to that
 checkpoint; it refuses checkpoints written under another config (``checkpoints/run.yaml``
 records the config that wrote them; only :data:`RESUMABLE_CHANGES` may differ).
@@ -25,6 +27,7 @@ prints one line saying how to continue and exits with status 130.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import functools
 import importlib.util
 import io
@@ -55,6 +58,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, Ve
 
 import etsc_envs
 from agents.config import TrainConfig, load_config
+from agents.decision_selection import BEST_DECISION, select_decision
 from agents.decisions import make_decision_env
 from agents.elapsed_discount import (
     ElapsedRolloutBuffer,
@@ -72,6 +76,7 @@ MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
 SUMMARY_FILE = "train_summary.json"
 EVALUATIONS_FILE = "evaluations.json"
+SELECTION_FILE = "decision_selection.json"
 BEST_MODEL_FILE = "best_model.zip"
 """The model with the best mean return on the validation scenarios so far (checkpoint
 choice follows the test protocol), its observation statistics beside it."""
@@ -157,6 +162,10 @@ def _train(
     checkpoint: Path | None,
     callbacks: Sequence[BaseCallback],
 ) -> Path:
+    written = config
+    if config.imitation_decision == BEST_DECISION:
+        chosen = _selected_decision(config, out_dir, fresh=checkpoint is None)
+        config = dataclasses.replace(config, imitation_decision=chosen)
     env = _checked(
         "env_kwargs", make_training_env, config, checkpoint, exceptions=(TypeError, ValueError)
     )
@@ -165,7 +174,7 @@ def _train(
     imitation: dict[str, Any] | None = None
     if checkpoint is None:
         if config.checkpoint_every:
-            _write_config(config, out_dir / CHECKPOINT_DIR / RUN_FILE)
+            _write_config(written, out_dir / CHECKPOINT_DIR / RUN_FILE)
         if config.imitation_steps and decisions is not None:
             imitation = imitate_decision(
                 model,
@@ -211,12 +220,41 @@ def _train(
     wall_time_s = time.perf_counter() - start
     save_model(model, out_dir / MODEL_FILE, decisions)
     env.close()
-    _write_config(config, out_dir / CONFIG_FILE)
+    _write_config(written, out_dir / CONFIG_FILE)
     summary = _summary(config, model, metrics_callback, wall_time_s)
     summary["resumed_from"] = None if checkpoint is None else str(checkpoint)
     summary["imitation"] = imitation
     atomic_write_text(out_dir / SUMMARY_FILE, json.dumps(summary, indent=2) + "\n")
     return out_dir
+
+
+def _selected_decision(config: TrainConfig, out_dir: Path, fresh: bool) -> str:
+    """The decision an ``imitation_decision: best`` run starts from: chosen on the validation
+    scenarios at the run's env kwargs (:func:`~agents.decision_selection.select_decision`) and
+    recorded in ``out_dir/decision_selection.json`` on a fresh run, read back from there on a
+    resume."""
+    path = out_dir / SELECTION_FILE
+    if not fresh:
+        try:
+            return str(json.loads(path.read_text(encoding="utf-8"))["chosen"])
+        except (OSError, ValueError, KeyError) as error:
+            raise ValueError(
+                f"--resume: {path} does not say which decision the run started from ({error})"
+            ) from None
+    env = make_decision_env(config.env_id, config.env_kwargs, config.decisions)
+    decisions = env.decisions
+    env.close()
+    selection = select_decision(
+        config.env_id,
+        {**config.env_kwargs, **config.evaluation_env_kwargs},
+        decisions,
+        config.evaluation_scenarios,
+        config.imitation_candidates,
+    )
+    out_dir.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(path, json.dumps(selection, indent=2) + "\n")
+    print(f"imitation_decision: best at these env kwargs is {selection['chosen']!r}", flush=True)
+    return str(selection["chosen"])
 
 
 def _checked(

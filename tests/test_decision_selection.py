@@ -1,0 +1,154 @@
+"""Choosing the decision a self-triggered run starts from, per transmission penalty
+(``imitation_decision: best``, :mod:`agents.decision_selection`)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+import etsc_envs  # noqa: F401  (registers the ids)
+from agents.config import config_from_dict
+from agents.decision_selection import select_decision
+from agents.evaluation import set_summary
+from agents.train import main
+from baselines.batch import run_batch
+from baselines.cli import episode_setup
+from baselines.self_triggered import DecisionSet
+from etsc_envs.protocol import scenario_set
+
+ATTITUDE = "etsc/AttitudeTracking-v0"
+CANDIDATES = ["hold 1", "hold 4", "paper x1", "paper x4"]
+SHORT = {"horizon_s": 0.3}
+SET_SIZE = 2
+
+
+def selection_at(penalty: float) -> dict:
+    decisions = DecisionSet(ATTITUDE, max_exponent=3, factors=(1.0, 4.0))
+    kwargs = {**SHORT, "randomize": True, "transmission_penalty": penalty}
+    return select_decision(ATTITUDE, kwargs, decisions, SET_SIZE, CANDIDATES)
+
+
+def run_stand_alone(spec: str, policy_args: dict, penalty: float) -> dict:
+    """The set summary of a stand-alone policy on the same validation scenarios."""
+    scenarios = scenario_set("validation", SET_SIZE)
+    kwargs = scenarios.env_kwargs({**SHORT, "transmission_penalty": penalty})
+    setup = episode_setup(ATTITUDE, kwargs)
+    policy = setup.make_policy(spec, policy_args)
+    setup.env.close()
+    return set_summary(run_batch(ATTITUDE, policy, scenarios.seeds, kwargs))
+
+
+def test_each_candidate_is_scored_as_its_baseline_and_the_best_return_wins():
+    """"hold 4" always taken is the clock every 4 instants, "paper x1" the paper's rule (after
+    the transmission at the episode's start that every hold sends): their summaries are those
+    baselines' on the same validation scenarios, and the chosen label has the highest return."""
+    penalty = 0.1
+    selection = selection_at(penalty)
+    summaries = selection["candidates"]
+    assert list(summaries) == CANDIDATES
+    clock = run_stand_alone("periodic", {"every": 4}, penalty)
+    for key in ("mean_cost", "transmissions", "return"):
+        assert summaries["hold 4"][key] == pytest.approx(clock[key], rel=1e-12)
+    paper = run_stand_alone("paper", {}, penalty)
+    assert summaries["paper x1"]["mean_cost"] == pytest.approx(paper["mean_cost"], rel=1e-9)
+    assert abs(summaries["paper x1"]["transmissions"] - paper["transmissions"]) <= 1
+    returns = {label: summary["return"] for label, summary in summaries.items()}
+    assert returns[selection["chosen"]] == max(returns.values())
+    assert selection["scenarios"] == scenario_set("validation", SET_SIZE).describe()
+
+
+def test_the_choice_moves_to_sparser_decisions_as_transmissions_get_dearer():
+    """With no price on a transmission the most accurate candidate wins, with a prohibitive
+    one the sparsest: the choice follows λ (the returns differ by λ × transmissions alone)."""
+    free = selection_at(0.0)
+    dear = selection_at(1.0e6)
+    costs = {label: summary["mean_cost"] for label, summary in free["candidates"].items()}
+    sent = {label: summary["transmissions"] for label, summary in dear["candidates"].items()}
+    assert free["chosen"] == min(costs, key=costs.get)
+    assert dear["chosen"] == min(sent, key=sent.get)
+    assert free["chosen"] != dear["chosen"]
+    for label in CANDIDATES:
+        assert free["candidates"][label]["mean_cost"] == dear["candidates"][label]["mean_cost"]
+        assert np.isclose(
+            free["candidates"][label]["return"] - dear["candidates"][label]["return"],
+            1.0e6 * free["candidates"][label]["transmissions"],
+            rtol=1e-9,
+        )
+
+
+def test_an_unknown_candidate_is_refused_by_name():
+    decisions = DecisionSet(ATTITUDE, max_exponent=3)
+    with pytest.raises(ValueError, match="imitation_candidates: 'hold 64'"):
+        select_decision(ATTITUDE, SHORT, decisions, SET_SIZE, ["hold 1", "hold 64"])
+
+
+BASE_CONFIG = {
+    "env_id": ATTITUDE,
+    "env_kwargs": SHORT,
+    "algorithm": "PPO",
+    "policy": "MlpPolicy",
+    "total_timesteps": 32,
+    "decisions": {"max_exponent": 3, "factors": [1.0, 4.0]},
+    "imitation_steps": 64,
+}
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        (
+            {"imitation_decision": "hold 1", "imitation_candidates": ["hold 1"]},
+            "'imitation_candidates' needs 'imitation_decision: best'",
+        ),
+        (
+            {"imitation_decision": "best", "imitation_candidates": []},
+            "'imitation_candidates' must be a non-empty list",
+        ),
+        (
+            {"imitation_decision": "best", "imitation_candidates": ["hold 64"]},
+            "'imitation_candidates': 'hold 64' is not a decision of this set",
+        ),
+    ],
+)
+def test_the_config_checks_the_candidates(tmp_path, changes, message):
+    with pytest.raises(ValueError, match=message):
+        config_from_dict({**BASE_CONFIG, "out_dir": str(tmp_path / "run"), **changes})
+
+
+def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path):
+    """``imitation_decision: best`` records the choice beside the model, clones and pins that
+    decision, and a resumed run reads it back instead of choosing again."""
+    out_dir = tmp_path / "run"
+    config = {
+        **BASE_CONFIG,
+        "env_kwargs": {**SHORT, "transmission_penalty": 1.0e6},
+        "hyperparameters": {"n_steps": 16, "batch_size": 16, "n_epochs": 1, "gamma": 0.999},
+        "total_timesteps": 32,
+        "n_envs": 1,
+        "out_dir": str(out_dir),
+        "imitation_decision": "best",
+        "imitation_candidates": CANDIDATES,
+        "imitation_epochs": 5,
+        "imitation_pinned_probability": 0.9,
+        "evaluation_scenarios": SET_SIZE,
+        "checkpoint_every": 16,
+        "tensorboard": False,
+    }
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    assert main(["--config", str(path), "--timesteps", "16"]) == 0
+    selection = json.loads((out_dir / "decision_selection.json").read_text(encoding="utf-8"))
+    assert selection == json.loads(json.dumps(selection_at(1.0e6)))
+    summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    assert summary["imitation"]["decision"] == f"{selection['chosen']}, pinned at probability 0.9"
+    assert yaml.safe_load((out_dir / "config.yaml").read_text())["imitation_decision"] == "best"
+    (out_dir / "decision_selection.json").write_text(json.dumps({"chosen": "hold 1"}))
+    assert main(["--config", str(path), "--resume"]) == 0
+    resumed = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    assert resumed["resumed_from"] is not None and resumed["total_timesteps"] >= 32
+    (out_dir / "decision_selection.json").unlink()
+    with pytest.raises(SystemExit):
+        main(["--config", str(path), "--resume"])
