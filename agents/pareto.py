@@ -52,6 +52,7 @@ from matplotlib import ticker
 
 import etsc_envs
 from agents.evaluation import episode_summary
+from agents.front import front_verdict, paper_scenario_axes, verdict_line
 from agents.sweep_results import sweep_models
 from baselines.cli import limit_torch_threads, parse_assignments, require_policies, write_json
 from baselines.evaluate import evaluate
@@ -261,13 +262,33 @@ def pareto(
         {**point(f"sb3:{path}", {}), "method": method}
         for path, method in zip(models, methods, strict=True)
     ] + read
-    return {
+    result = {
         "env": env_id,
         "env_kwargs": env_kwargs,
         "scenarios": scenarios,
         "set_size": set_size,
         "curves": curves,
     }
+    result["fronts"] = front_verdicts(result)
+    return result
+
+
+def front_verdicts(result: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Each learned method's front against the paper and periodic sweeps
+    (:func:`agents.front.front_verdict`), on the scenario set (``set``) and on the paper
+    scenario (``paper``, where its points ran there)."""
+    curves = result["curves"]
+    verdicts: dict[str, dict[str, Any]] = {}
+    for method, points in learned_methods(result):
+        verdicts[method] = {"set": front_verdict(points, curves["paper"], curves["periodic"])}
+        if all(point.get("paper_scenario") is not None for point in points):
+            try:
+                verdicts[method]["paper"] = front_verdict(
+                    points, curves["paper"], curves["periodic"], paper_scenario_axes
+                )
+            except ValueError:
+                continue
+    return verdicts
 
 
 def non_dominated(points: list[dict[str, Any]], cost: Any, sent: Any) -> list[dict[str, Any]]:
@@ -298,13 +319,20 @@ def series(result: dict[str, Any]) -> list[tuple[tuple[str, str, str, str], list
     result has one, then one per learned method (in order of appearance), each with its
     (marker, line, colour, label)."""
     drawn = [(STYLES[name], result["curves"][name]) for name in STYLES if name in result["curves"]]
-    learned = result["curves"].get("learned", [])
-    methods = list(dict.fromkeys(point.get("method", LEARNED) for point in learned))
-    for index, method in enumerate(methods):
+    for index, (method, points) in enumerate(learned_methods(result)):
         marker, line, color = LEARNED_STYLES[index % len(LEARNED_STYLES)]
-        points = [point for point in learned if point.get("method", LEARNED) == method]
         drawn.append(((marker, line, color, method), points))
     return drawn
+
+
+def learned_methods(result: dict[str, Any]) -> list[tuple[str, list[dict[str, Any]]]]:
+    """Each learned method of ``result`` (in order of appearance) with its points."""
+    learned = result["curves"].get("learned", [])
+    methods = list(dict.fromkeys(point.get("method", LEARNED) for point in learned))
+    return [
+        (method, [point for point in learned if point.get("method", LEARNED) == method])
+        for method in methods
+    ]
 
 
 def _draw_set(axes: plt.Axes, result: dict[str, Any]) -> None:
@@ -499,6 +527,10 @@ def main(argv: list[str] | None = None) -> int:
                 f"{name:9s} {json.dumps(point['args'])[:40]:40s} mean_cost {cost['mean']:.4g} "
                 f"transmissions {sent['mean']:.4g} failures {point['failures']}"
             )
+    for method, verdicts in result["fronts"].items():
+        for where, verdict in verdicts.items():
+            place = "paper scenario" if where == "paper" else f"{args.scenarios} set"
+            print(verdict_line(method, place, verdict))
     print(f"wrote {out_dir / 'pareto.json'} and {out_dir / 'pareto.png'}")
     return 0
 

@@ -42,7 +42,7 @@ def run_stand_alone(spec: str, policy_args: dict, penalty: float) -> dict:
 
 
 def test_each_candidate_is_scored_as_its_baseline_and_the_best_return_wins():
-    """"hold 4" always taken is the clock every 4 instants, "paper x1" the paper's rule (after
+    """ "hold 4" always taken is the clock every 4 instants, "paper x1" the paper's rule (after
     the transmission at the episode's start that every hold sends): their summaries are those
     baselines' on the same validation scenarios, and the chosen label has the highest return."""
     penalty = 0.1

@@ -1,0 +1,108 @@
+"""The front criterion: a learned front on or below the paper and periodic sweeps over the
+paper sweep's range of transmissions (:mod:`agents.front`)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from agents.front import envelope, envelope_cost, front_verdict, paper_scenario_axes
+from agents.pareto import front_verdicts
+
+
+def point(sent: float, cost: float, failures: int = 0, paper: tuple | None = None) -> dict:
+    """A point as :func:`agents.pareto.pareto` writes it (set aggregates, paper episode)."""
+    episode = None
+    if paper is not None:
+        episode = {"transmissions": paper[0], "mean_cost": paper[1], "failure": None}
+    return {
+        "transmissions": {"mean": sent},
+        "mean_cost": {"mean": cost},
+        "failures": failures,
+        "paper_scenario": episode,
+    }
+
+
+PAPER = [point(100, 4.0), point(200, 3.0), point(400, 2.0)]
+PERIODIC = [point(50, 9.0, failures=3), point(100, 5.0), point(400, 1.5), point(800, 1.8)]
+
+
+def test_the_envelope_keeps_the_best_cost_within_each_budget():
+    front = envelope([(800, 1.8), (100, 5.0), (400, 1.5), (200, 6.0)])
+    assert front == [(100, 5.0), (400, 1.5)]
+    assert envelope_cost(front, 50) is None  # no point that sparse
+    assert envelope_cost(front, 100) == 5.0
+    # halfway in log(transmissions) between 100 and 400, halfway in cost
+    assert envelope_cost(front, 200) == pytest.approx(3.25)
+    assert envelope_cost(front, 10_000) == 1.5  # sending less than the budget is allowed
+
+
+def test_a_front_below_both_sweeps_over_the_range_meets_the_criterion():
+    learned = [point(90, 3.5), point(150, 2.6), point(400, 1.4)]
+    verdict = front_verdict(learned, PAPER, PERIODIC)
+    assert verdict["range"] == [100, 400]
+    assert verdict["learned_range"] == [90, 400]
+    assert verdict["paper"]["met"] and verdict["periodic"]["met"] and verdict["met"]
+    assert verdict["periodic"]["worst_ratio"] < 1
+
+
+def test_a_single_point_does_not_cover_the_range():
+    """One learned point cheaper than both sweeps where it sits, but the paper sweep reaches
+    sparser: the front does not cover the range, whatever its ratios."""
+    verdict = front_verdict([point(150, 1.0)], PAPER, PERIODIC)
+    assert not verdict["paper"]["covers"] and not verdict["met"]
+
+
+def test_a_front_above_a_sweep_between_its_own_points_is_caught():
+    """Learned points each below the clock's envelope at their own transmissions (5 at 100,
+    1.5 from 400 on), but the join between them passes above the clock's point at 400: the
+    check at every breakpoint of both envelopes sees it."""
+    learned = [point(100, 3.9), point(1600, 1.0)]
+    verdict = front_verdict(learned, PAPER, PERIODIC)
+    assert verdict["periodic"]["worst_at"] == 400
+    assert verdict["periodic"]["worst_ratio"] == pytest.approx((3.9 - 2.9 * 2 / 4) / 1.5)
+    assert not verdict["periodic"]["met"]
+
+
+def test_failed_points_are_not_points_of_a_curve():
+    """A learned point with failures does not count, and the clock that fails (every 50
+    instants here, hypothetically cheap) sets no bound."""
+    learned = [point(90, 0.1, failures=1), point(100, 3.5), point(400, 1.4)]
+    verdict = front_verdict(learned, PAPER, [*PERIODIC, point(60, 0.01, failures=64)])
+    assert verdict["learned_range"] == [100, 400] and verdict["met"]
+    with pytest.raises(ValueError, match="no failure-free point"):
+        front_verdict([point(100, 1.0, failures=2)], PAPER, PERIODIC)
+
+
+def test_zero_costs_compare_exactly():
+    """Paper 003's orbit may stay inside its shell (cost 0): 0 against 0 is a tie, anything
+    above 0 against 0 is infinitely worse."""
+    assert front_verdict([point(100, 0.0)], [point(100, 0.0)], [point(100, 0.0)])["met"]
+    verdict = front_verdict([point(100, 0.1)], [point(100, 0.0)], [point(100, 1.0)])
+    assert verdict["paper"]["worst_ratio"] == math.inf and not verdict["met"]
+
+
+def test_the_paper_scenario_is_judged_on_its_own_episode():
+    learned = [point(100, 9.0, paper=(80, 1.0))]
+    paper = [point(100, 1.0, paper=(100, 2.0))]
+    periodic = [point(100, 1.0, paper=(100, 3.0))]
+    assert not front_verdict(learned, paper, periodic)["met"]
+    assert front_verdict(learned, paper, periodic, paper_scenario_axes)["met"]
+
+
+def test_pareto_judges_every_learned_method_on_the_set_and_the_paper_scenario():
+    result = {
+        "curves": {
+            "paper": [point(100, 4.0, paper=(100, 4.0)), point(400, 2.0, paper=(400, 2.0))],
+            "periodic": [point(100, 5.0, paper=(100, 5.0))],
+            "learned": [
+                {**point(90, 3.0, paper=(90, 3.0)), "method": "front"},
+                {**point(400, 1.0, paper=(400, 1.0)), "method": "front"},
+                {**point(300, 3.0), "method": "single"},
+            ],
+        }
+    }
+    verdicts = front_verdicts(result)
+    assert verdicts["front"]["set"]["met"] and verdicts["front"]["paper"]["met"]
+    assert "paper" not in verdicts["single"] and not verdicts["single"]["set"]["met"]
