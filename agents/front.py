@@ -119,9 +119,9 @@ def front_verdict(
     :func:`agents.pareto.pareto`'s curves), on the axes ``axes`` reads (:func:`set_axes`, the
     scenario set; :func:`paper_scenario_axes`, the paper scenario). Points with failures are
     left out of every curve. Returns the paper sweep's ``range`` of transmissions, the
-    learned front's, a :func:`compare` of each sweep (``paper``, ``periodic``) and ``met``
-    (both); ``ValueError`` if the paper sweep or the learned points have no failure-free
-    point."""
+    learned front's (``None`` if every learned point failed: the criterion is then not met), a
+    :func:`compare` of each sweep (``paper``, ``periodic``) and ``met`` (both); ``ValueError``
+    if the paper sweep has no failure-free point."""
 
     def pairs(points: list[dict[str, Any]], on_set_failures: bool) -> list[tuple[float, float]]:
         kept = []
@@ -138,9 +138,16 @@ def front_verdict(
     learned_pairs = pairs(learned, on_set)
     if not paper_pairs:
         raise ValueError("the paper sweep has no failure-free point to span a range")
-    if not learned_pairs:
-        raise ValueError("the learned front has no failure-free point")
     span = (min(sent for sent, _ in paper_pairs), max(sent for sent, _ in paper_pairs))
+    if not learned_pairs:
+        empty = {"covers": False, "worst_ratio": None, "worst_at": None, "met": False}
+        return {
+            "range": list(span),
+            "learned_range": None,
+            "paper": empty,
+            "periodic": empty,
+            "met": False,
+        }
     against = {
         "paper": compare(learned_pairs, paper_pairs, span),
         "periodic": compare(learned_pairs, pairs(periodic, on_set), span),
@@ -159,6 +166,8 @@ def front_verdict(
 def verdict_line(method: str, where: str, verdict: dict[str, Any]) -> str:
     """One line saying what :func:`front_verdict` found."""
     low, high = verdict["range"]
+    if verdict["learned_range"] is None:
+        return f"{method}, {where}: every learned point failed; front criterion not met"
     learned_low, learned_high = verdict["learned_range"]
     parts = []
     for sweep in ("paper", "periodic"):

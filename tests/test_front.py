@@ -7,7 +7,13 @@ import math
 
 import pytest
 
-from agents.front import envelope, envelope_cost, front_verdict, paper_scenario_axes
+from agents.front import (
+    envelope,
+    envelope_cost,
+    front_verdict,
+    paper_scenario_axes,
+    verdict_line,
+)
 from agents.pareto import front_verdicts
 
 
@@ -71,8 +77,11 @@ def test_failed_points_are_not_points_of_a_curve():
     learned = [point(90, 0.1, failures=1), point(100, 3.5), point(400, 1.4)]
     verdict = front_verdict(learned, PAPER, [*PERIODIC, point(60, 0.01, failures=64)])
     assert verdict["learned_range"] == [100, 400] and verdict["met"]
-    with pytest.raises(ValueError, match="no failure-free point"):
-        front_verdict([point(100, 1.0, failures=2)], PAPER, PERIODIC)
+    failed = front_verdict([point(100, 1.0, failures=2)], PAPER, PERIODIC)
+    assert failed["learned_range"] is None and not failed["met"]
+    assert "every learned point failed" in verdict_line("m", "set", failed)
+    with pytest.raises(ValueError, match="paper sweep has no failure-free point"):
+        front_verdict([point(100, 1.0)], [point(100, 1.0, failures=1)], PERIODIC)
 
 
 def test_zero_costs_compare_exactly():
