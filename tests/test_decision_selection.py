@@ -11,13 +11,15 @@ import yaml
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.config import config_from_dict
-from agents.decision_selection import select_decision
-from agents.evaluation import set_summary
+from agents.decision_selection import constant_decision_policy, select_decision, stand_alone_spec
+from agents.evaluation import deployment, set_summary
+from agents.imitation import FixedDecision
 from agents.train import main
 from baselines.batch import run_batch
 from baselines.cli import episode_setup
-from baselines.self_triggered import DecisionSet
+from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
 from etsc_envs.protocol import scenario_set
+from etsc_envs.triggers.base import RuleTrigger
 
 ATTITUDE = "etsc/AttitudeTracking-v0"
 CANDIDATES = ["hold 1", "hold 4", "paper x1", "paper x4"]
@@ -152,3 +154,66 @@ def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path
     (out_dir / "decision_selection.json").unlink()
     with pytest.raises(SystemExit):
         main(["--config", str(path), "--resume"])
+
+
+@pytest.mark.parametrize(
+    ("env_id", "env_kwargs", "decision_keywords", "labels"),
+    [
+        (ATTITUDE, SHORT, {"max_exponent": 3, "factors": (2.0,)}, ["hold 4", "paper x2"]),
+        (
+            "etsc/InnerFormation-v0",
+            {"horizon_s": 0.5},
+            {"max_exponent": 3, "rule": "error_time", "factors": (2.0,)},
+            ["hold 8", "error_time x2"],
+        ),
+        (
+            "etsc/ClusterContainmentCentral-v0",
+            {"horizon_s": 20.0},
+            {"max_exponent": 5, "factors": (1.5,)},
+            ["hold 16", "paper x1.5"],
+        ),
+        (
+            "etsc/ClusterContainment-v0",
+            {"horizon_s": 20.0},
+            {"max_exponent": 5, "factors": (0.5,)},
+            ["hold 32", "paper x0.5"],
+        ),
+    ],
+)
+def test_a_stand_alone_trigger_takes_the_constant_decisions_actions(
+    env_id, env_kwargs, decision_keywords, labels
+):
+    """Where a decision always taken is a stand-alone trigger (the clock, the rule at a
+    scaled threshold), the compiled run of that trigger gives the records of the deployed
+    decision policy, one Python call per instant: the same transmissions, cost and return."""
+    decisions = DecisionSet(env_id, **decision_keywords)
+    seeds = scenario_set("validation", SET_SIZE).seeds
+    deployed = deployment(env_id, env_kwargs, decisions)
+    setup = episode_setup(env_id, env_kwargs)
+    for label in labels:
+        action = decisions.action(label)
+        assert stand_alone_spec(decisions, action) is not None
+        compiled = constant_decision_policy(setup, deployed, decisions, action)
+        assert isinstance(compiled, RuleTrigger)
+        reference = SelfTriggeredPolicy(FixedDecision(action), *deployed)
+        for fast, slow in zip(
+            run_batch(env_id, compiled, seeds, env_kwargs),
+            run_batch(env_id, reference, seeds, env_kwargs),
+            strict=True,
+        ):
+            assert fast["transmissions"] > 0
+            for key in ("transmissions", "mean_cost", "return", "failure"):
+                assert fast[key] == slow[key], (label, key)
+    setup.env.close()
+
+
+def test_decisions_with_a_forced_transmission_or_a_shield_run_as_decisions():
+    """A heartbeat's or a floor's forced transmission at each decision instant, and a shield
+    that may replace a choice, have no stand-alone trigger: those run as decisions."""
+    heartbeat = DecisionSet(ATTITUDE, max_exponent=3, factors=(2.0,), rule_heartbeat=True)
+    assert stand_alone_spec(heartbeat, heartbeat.action("paper x2, heartbeat 8")) is None
+    assert stand_alone_spec(heartbeat, heartbeat.action("hold 8")) == ("periodic", {"every": 8})
+    shielded = DecisionSet(
+        "etsc/InnerFormation-v0", max_exponent=3, shield_multiple=2.0, sampling_period_s=0.01
+    )
+    assert stand_alone_spec(shielded, shielded.action("hold 1")) is None
