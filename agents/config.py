@@ -58,6 +58,9 @@ A config is a YAML mapping with these keys (the optional ones show their default
   baseline;
 * ``imitation_candidates: null`` — with ``imitation_decision: best``, the labels it chooses
   among (``null``: every decision of the set);
+* ``imitation_selection_cache: null`` — with ``imitation_decision: best``, a folder in which
+  runs that differ in their transmission penalty alone (a front's trials) share the
+  candidates' validation runs (:func:`agents.decision_selection.select_decision`);
 * ``imitation_pinned_probability: null`` — with ``imitation_decision``, a probability p in
   (0, 1): after cloning, the policy's action head is set to take the cloned decision with
   probability p at every observation (:func:`agents.imitation.pin_decision`), so that
@@ -134,6 +137,7 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "imitation_epochs": 10,
     "imitation_decision": None,
     "imitation_candidates": None,
+    "imitation_selection_cache": None,
     "imitation_pinned_probability": None,
     "decisions": None,
 }
@@ -169,6 +173,7 @@ class TrainConfig:
     imitation_epochs: int
     imitation_decision: str | None
     imitation_candidates: list[str] | None
+    imitation_selection_cache: str | None
     imitation_pinned_probability: float | None
     decisions: dict[str, Any] | None
 
@@ -239,6 +244,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
         imitation_decision=values["imitation_decision"],
         imitation_candidates=values["imitation_candidates"],
+        imitation_selection_cache=_check_selection_cache(values),
         imitation_pinned_probability=_check_pinned_probability(values),
         decisions=decisions,
     )
@@ -342,6 +348,23 @@ def _check_decisions(
     finally:
         wrapper.close()
     return decisions
+
+
+def _check_selection_cache(values: Mapping[str, Any]) -> str | None:
+    """``values["imitation_selection_cache"]``: null, or a folder path beside
+    ``imitation_decision: best``."""
+    folder = values["imitation_selection_cache"]
+    if folder is None:
+        return None
+    if values["imitation_decision"] != BEST_DECISION:
+        raise ValueError(
+            f"config key 'imitation_selection_cache' needs 'imitation_decision: {BEST_DECISION}'"
+        )
+    if not isinstance(folder, str) or not folder:
+        raise ValueError(
+            f"config key 'imitation_selection_cache' must be a folder path or null, got {folder!r}"
+        )
+    return folder
 
 
 def _check_labels(values: Mapping[str, Any], decisions: DecisionSet) -> None:

@@ -22,6 +22,11 @@ paths give the same records.
 
 from __future__ import annotations
 
+import hashlib
+import json
+from collections.abc import Sequence
+from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -30,7 +35,9 @@ from agents.evaluation import deployment, set_summary
 from agents.imitation import FixedDecision
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
+from baselines.episodes import to_jsonable
 from baselines.self_triggered import DecisionSet, IntervalSchedule, SelfTriggeredPolicy
+from etsc_envs.core.files import atomic_write_text
 from etsc_envs.protocol import scenario_set
 from etsc_envs.triggers import RULE_FAMILIES
 
@@ -79,15 +86,21 @@ def select_decision(
     decisions: DecisionSet,
     set_size: int,
     candidates: list[str] | None = None,
+    cache_dir: str | Path | None = None,
 ) -> dict[str, Any]:
     """The decision of ``decisions`` with the highest mean return over the first
     ``set_size`` validation scenarios when taken at every decision, among ``candidates``
     (labels; ``None``: every action of the set).
 
-    ``env_kwargs`` are the training env's (the set's ``randomize`` replaces theirs); the
-    return is the env's reward summed over the episode, so it prices transmissions at the
-    env's ``transmission_penalty``. Ties go to the earlier candidate. Returns ``{"chosen":
-    label, "scenarios": the set described, "candidates": {label: set summary}}`` (each summary
+    ``env_kwargs`` are the training env's (the set's ``randomize`` replaces theirs). The
+    return is the env's reward summed over the episode, ``-Σ cost / cost_scale - λ ·
+    (channels sent)`` (failures charge the same whatever λ): the candidates run once with no
+    price on a transmission, and each one's return at the env's λ is that return less λ times
+    its transmissions. Runs that differ in λ alone (a front's trials) may therefore share the
+    candidates' runs through ``cache_dir``: a folder holding one JSON file per env (less its
+    λ), decision set, scenario set and candidate list, written by the first run that needs it.
+    Ties go to the earlier candidate. Returns ``{"chosen": label, "transmission_penalty": λ,
+    "scenarios": the set described, "candidates": {label: set summary at λ}}`` (each summary
     :func:`agents.evaluation.set_summary`'s); ``ValueError`` naming ``imitation_candidates``
     for a label the set lacks.
     """
@@ -104,18 +117,73 @@ def select_decision(
         raise ValueError(f"imitation_candidates: {error}") from None
     scenarios = scenario_set("validation", set_size)
     base = {key: value for key, value in env_kwargs.items() if key != "randomize"}
-    kwargs = scenarios.env_kwargs(base)
-    deployed = deployment(env_id, kwargs, decisions)
-    setup = episode_setup(env_id, kwargs)
+    penalty = transmission_penalty(env_id, scenarios.env_kwargs(base))
+    free = scenarios.env_kwargs({**base, "transmission_penalty": 0.0})
+    key = {
+        "env_id": env_id,
+        "env_kwargs": dict(free),
+        "decisions": asdict(decisions),
+        "scenarios": scenarios.describe(),
+        "candidates": labels,
+    }
+    cached = _cache_file(cache_dir, key)
+    if cached is not None and cached.is_file():
+        unpriced = json.loads(cached.read_text(encoding="utf-8"))["candidates"]
+    else:
+        unpriced = _run_candidates(env_id, free, decisions, scenarios.seeds, labels, actions)
+        if cached is not None:
+            cached.parent.mkdir(parents=True, exist_ok=True)
+            record = {"key": key, "candidates": unpriced}
+            atomic_write_text(cached, json.dumps(to_jsonable(record), indent=2) + "\n")
+    summaries = {
+        label: {**summary, "return": summary["return"] - penalty * summary["transmissions"]}
+        for label, summary in unpriced.items()
+    }
+    chosen = max(labels, key=lambda label: summaries[label]["return"])
+    return {
+        "chosen": chosen,
+        "transmission_penalty": penalty,
+        "scenarios": scenarios.describe(),
+        "candidates": summaries,
+    }
+
+
+def transmission_penalty(env_id: str, env_kwargs: dict[str, Any]) -> float:
+    """λ of ``env_id`` built with ``env_kwargs`` (the env's default where they do not set it)."""
+    setup = episode_setup(env_id, env_kwargs)
+    try:
+        env = setup.env.unwrapped
+        return float(getattr(env, "loop", env).transmission_penalty)
+    finally:
+        setup.env.close()
+
+
+def _cache_file(cache_dir: str | Path | None, key: dict[str, Any]) -> Path | None:
+    """Where the unpriced runs of ``key`` live in ``cache_dir`` (``None``: no cache)."""
+    if cache_dir is None:
+        return None
+    text = json.dumps(to_jsonable(key), sort_keys=True)
+    return Path(cache_dir) / f"{hashlib.sha256(text.encode()).hexdigest()[:16]}.json"
+
+
+def _run_candidates(
+    env_id: str,
+    env_kwargs: dict[str, Any],
+    decisions: DecisionSet,
+    seeds: Sequence[int],
+    labels: list[str],
+    actions: list[int],
+) -> dict[str, dict[str, Any]]:
+    """Each candidate decision, always taken, on ``seeds``: its set summary."""
+    deployed = deployment(env_id, env_kwargs, decisions)
+    setup = episode_setup(env_id, env_kwargs)
     try:
         policies = [
             constant_decision_policy(setup, deployed, decisions, action) for action in actions
         ]
     finally:
         setup.env.close()
-    summaries = {
-        label: set_summary(run_batch(env_id, policy, scenarios.seeds, kwargs))
+    return {
+        label: set_summary(run_batch(env_id, policy, seeds, env_kwargs))
         for label, policy in zip(labels, policies, strict=True)
     }
-    chosen = max(labels, key=lambda label: summaries[label]["return"])
-    return {"chosen": chosen, "scenarios": scenarios.describe(), "candidates": summaries}

@@ -35,7 +35,8 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
 Keys of ``overrides``, ``grid`` and ``search`` are training-config keys, dotted to reach into
 a mapping: ``seed``, ``total_timesteps``, ``env_kwargs.transmission_penalty``,
 ``hyperparameters.learning_rate``. Paths (``base``, ``results_dir``, the training config's
-``init_from``) are relative to the current folder, as in ``agents.train``.
+``init_from``, ``imitation_selection_cache``) are relative to the current folder, as in
+``agents.train``.
 
 Every problem raises a one-line ``ValueError`` naming the key and what it allows.
 """
@@ -189,6 +190,7 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
         _assign(base, key, value)
     base["out_dir"] = "<trial folder>"
     base["init_from"] = _absolute(base.get("init_from"))
+    base["imitation_selection_cache"] = _absolute(base.get("imitation_selection_cache"))
     grid = _check_grid(values["grid"])
     search = _check_search(values["search"])
     overlap = sorted(set(grid) & set(search))
@@ -308,8 +310,8 @@ def _check_mapping(key: str, value: Any) -> dict[str, Any]:
 
 
 def _absolute(path: Any) -> Any:
-    """A model path as an absolute path (trials run in other folders), other values as they
-    are."""
+    """A path (a model, a cache folder) as an absolute path (trials run in other folders),
+    other values as they are."""
     return str(Path(path).resolve()) if isinstance(path, str) else path
 
 

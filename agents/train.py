@@ -250,6 +250,7 @@ def _selected_decision(config: TrainConfig, out_dir: Path, fresh: bool) -> str:
         decisions,
         config.evaluation_scenarios,
         config.imitation_candidates,
+        config.imitation_selection_cache,
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     atomic_write_text(path, json.dumps(selection, indent=2) + "\n")

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pytest
 import yaml
 
@@ -64,7 +63,7 @@ def test_each_candidate_is_scored_as_its_baseline_and_the_best_return_wins():
 
 def test_the_choice_moves_to_sparser_decisions_as_transmissions_get_dearer():
     """With no price on a transmission the most accurate candidate wins, with a prohibitive
-    one the sparsest: the choice follows λ (the returns differ by λ × transmissions alone)."""
+    one the sparsest."""
     free = selection_at(0.0)
     dear = selection_at(1.0e6)
     costs = {label: summary["mean_cost"] for label, summary in free["candidates"].items()}
@@ -72,13 +71,31 @@ def test_the_choice_moves_to_sparser_decisions_as_transmissions_get_dearer():
     assert free["chosen"] == min(costs, key=costs.get)
     assert dear["chosen"] == min(sent, key=sent.get)
     assert free["chosen"] != dear["chosen"]
-    for label in CANDIDATES:
-        assert free["candidates"][label]["mean_cost"] == dear["candidates"][label]["mean_cost"]
-        assert np.isclose(
-            free["candidates"][label]["return"] - dear["candidates"][label]["return"],
-            1.0e6 * free["candidates"][label]["transmissions"],
-            rtol=1e-9,
-        )
+    assert dear["transmission_penalty"] == 1.0e6
+
+
+def test_runs_that_differ_in_lambda_alone_share_the_candidates_runs(tmp_path):
+    """The first selection writes the unpriced runs into the cache; a selection at another λ
+    reads them (a changed file shows it was read) and prices them at its own λ, which gives
+    what running at that λ gives."""
+    decisions = DecisionSet(ATTITUDE, max_exponent=3, factors=(1.0, 4.0))
+    cache = tmp_path / "cache"
+
+    def select(penalty: float) -> dict:
+        kwargs = {**SHORT, "transmission_penalty": penalty}
+        return select_decision(ATTITUDE, kwargs, decisions, SET_SIZE, CANDIDATES, cache)
+
+    first = select(0.1)
+    (written,) = cache.iterdir()
+    assert first == selection_at(0.1)
+    assert select(1.0e6) == selection_at(1.0e6)
+    record = json.loads(written.read_text(encoding="utf-8"))
+    record["candidates"]["hold 4"]["mean_cost"] = -1.0
+    written.write_text(json.dumps(record), encoding="utf-8")
+    assert select(3.0)["candidates"]["hold 4"]["mean_cost"] == -1.0
+    other = DecisionSet(ATTITUDE, max_exponent=2, factors=(1.0, 4.0))
+    select_decision(ATTITUDE, SHORT, other, SET_SIZE, CANDIDATES, cache)
+    assert len(list(cache.iterdir())) == 2  # another decision set: runs of its own
 
 
 def test_an_unknown_candidate_is_refused_by_name():
@@ -113,6 +130,10 @@ BASE_CONFIG = {
             {"imitation_decision": "best", "imitation_candidates": ["hold 64"]},
             "'imitation_candidates': 'hold 64' is not a decision of this set",
         ),
+        (
+            {"imitation_decision": "hold 1", "imitation_selection_cache": "cache"},
+            "'imitation_selection_cache' needs 'imitation_decision: best'",
+        ),
     ],
 )
 def test_the_config_checks_the_candidates(tmp_path, changes, message):
@@ -133,6 +154,7 @@ def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path
         "out_dir": str(out_dir),
         "imitation_decision": "best",
         "imitation_candidates": CANDIDATES,
+        "imitation_selection_cache": str(tmp_path / "cache"),
         "imitation_epochs": 5,
         "imitation_pinned_probability": 0.9,
         "evaluation_scenarios": SET_SIZE,
@@ -144,6 +166,7 @@ def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path
     assert main(["--config", str(path), "--timesteps", "16"]) == 0
     selection = json.loads((out_dir / "decision_selection.json").read_text(encoding="utf-8"))
     assert selection == json.loads(json.dumps(selection_at(1.0e6)))
+    assert len(list((tmp_path / "cache").iterdir())) == 1
     summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
     assert summary["imitation"]["decision"] == f"{selection['chosen']}, pinned at probability 0.9"
     assert yaml.safe_load((out_dir / "config.yaml").read_text())["imitation_decision"] == "best"
