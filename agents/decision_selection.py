@@ -36,10 +36,14 @@ from agents.imitation import FixedDecision
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
-from baselines.self_triggered import DecisionSet, IntervalSchedule, SelfTriggeredPolicy
+from baselines.self_triggered import (
+    DecisionSet,
+    IntervalSchedule,
+    SelfTriggeredPolicy,
+    scaled_thresholds,
+)
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.protocol import scenario_set
-from etsc_envs.triggers import RULE_FAMILIES
 
 BEST_DECISION = "best"
 """The ``imitation_decision`` that asks :func:`select_decision` to choose per config."""
@@ -52,8 +56,9 @@ def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str
     heartbeat or a floor lets the rule at f times its threshold decide every instant, the
     decision instants included, and a capped interval hands over to the same rule (the rule
     named by the set, its thresholds scaled). ``None`` for a rule action with a heartbeat or a
-    floor (a forced transmission at each decision instant, which no stand-alone trigger of the
-    suite sends) and for every action of a shielded set (the shield may replace a choice)."""
+    floor (their stand-alone forms, where the suite has one, answer in Python every instant as
+    the decision policy does, so there is nothing to gain) and for every action of a shielded
+    set (the shield may replace a choice)."""
     if decisions.shield_multiple is not None:
         return None
     if action < decisions.n_holds:
@@ -61,8 +66,7 @@ def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str
     if decisions.rule_sends_first:
         return None
     factor = decisions.factors[action - decisions.n_holds]
-    thresholds = RULE_FAMILIES[decisions.rule][1][decisions.env_id]()
-    return decisions.rule, {name: factor * value for name, value in thresholds.items()}
+    return decisions.rule, scaled_thresholds(decisions.env_id, factor, decisions.rule)
 
 
 def constant_decision_policy(

@@ -243,6 +243,13 @@ class DecisionSet:
             raise ValueError(f"decision set {path} is not readable ({error})") from None
 
 
+def scaled_thresholds(env_id: str, factor: float, rule: str = "paper") -> dict[str, float]:
+    """The threshold keywords of ``env_id``'s ``rule`` trigger
+    (:data:`~etsc_envs.triggers.RULE_FAMILIES`) at ``factor`` times their default values."""
+    thresholds = RULE_FAMILIES[rule][1][env_id]()
+    return {name: factor * value for name, value in thresholds.items()}
+
+
 def scaled_rule_trigger(
     env_id: str,
     factor: float,
@@ -256,8 +263,8 @@ def scaled_rule_trigger(
     threshold keywords scaled by ``factor``, with a floor of ``floor_s`` seconds if given
     (:func:`~etsc_envs.triggers.base.floored_trigger_class`); ``ValueError`` naming ``factors``
     when the scaled values leave the trigger's range."""
-    triggers, thresholds = RULE_FAMILIES[rule]
-    scaled = {name: factor * value for name, value in thresholds[env_id]().items()}
+    triggers = RULE_FAMILIES[rule][0]
+    scaled = scaled_thresholds(env_id, factor, rule)
     try:
         if floor_s is not None:
             floored = floored_trigger_class(triggers[env_id])
