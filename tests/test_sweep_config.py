@@ -199,3 +199,18 @@ def test_model_paths_are_made_absolute_for_trials_that_run_elsewhere(
     trial = config.trial_config(config.grid_points()[0], config.trial_folder("t"))
     assert trial.init_from == str(tmp_path / "stage1.zip")
     assert config.results_dir == str(tmp_path / "out")
+
+
+def test_a_selection_cache_folder_is_made_absolute_for_trials_that_run_elsewhere(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every trial of a front shares the candidates' validation runs through one folder,
+    whichever folder the trial runs in."""
+    monkeypatch.chdir(tmp_path)
+    base = ROOT / "configs" / "train" / "attitude_tracking_self_triggered_selected.yaml"
+    raw = {**sweep(tmp_path, grid={"seed": [1]}, results_dir="out"), "base": str(base)}
+    raw["overrides"] = {"imitation_selection_cache": "cache"}
+    config = sweep_config_from_dict(raw)
+    trial = config.trial_config(config.grid_points()[0], config.trial_folder("t"))
+    assert trial.imitation_decision == "best"
+    assert trial.imitation_selection_cache == str(tmp_path / "cache")
