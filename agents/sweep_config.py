@@ -190,7 +190,8 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
         _assign(base, key, value)
     base["out_dir"] = "<trial folder>"
     base["init_from"] = _absolute(base.get("init_from"))
-    base["imitation_selection_cache"] = _absolute(base.get("imitation_selection_cache"))
+    if "imitation_selection_cache" in base:  # sweeps written before the key keep their settings
+        base["imitation_selection_cache"] = _absolute(base["imitation_selection_cache"])
     grid = _check_grid(values["grid"])
     search = _check_search(values["search"])
     overlap = sorted(set(grid) & set(search))
