@@ -179,9 +179,9 @@ def _run_candidates(
     actions: list[int],
 ) -> dict[str, dict[str, Any]]:
     """Each candidate decision, always taken, on ``seeds``: its set summary."""
-    deployed = deployment(env_id, env_kwargs, decisions)
     setup = episode_setup(env_id, env_kwargs)
     try:
+        deployed = deployment(setup, decisions)
         policies = [
             constant_decision_policy(setup, deployed, decisions, action) for action in actions
         ]

@@ -18,7 +18,7 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 from baselines.batch import run_batch
-from baselines.cli import episode_setup
+from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
 from baselines.policies import NormalizedModel, normalization_path
 from baselines.self_triggered import DecisionSet, IntervalSchedule, SelfTriggeredPolicy
@@ -46,16 +46,12 @@ def set_summary(records: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def deployment(
-    env_id: str, env_kwargs: dict[str, Any], decisions: DecisionSet
+    setup: EpisodeSetup, decisions: DecisionSet
 ) -> tuple[IntervalSchedule, gym.Space, gym.Space]:
     """The schedule of ``decisions`` and the transmit/hold spaces a policy of them acts in on
-    ``env_id`` (one agent's, for a PettingZoo id): the arguments of
+    the env of ``setup`` (one agent's, for a PettingZoo id): the arguments of
     :class:`~baselines.self_triggered.SelfTriggeredPolicy` after its model."""
-    setup = episode_setup(env_id, env_kwargs)
-    try:
-        observation_space, action_space, names = setup.policy_spaces()
-    finally:
-        setup.env.close()
+    observation_space, action_space, names = setup.policy_spaces()
     schedule = IntervalSchedule(decisions, observation_space, action_space, names)
     return schedule, observation_space, action_space
 
@@ -122,9 +118,9 @@ class PaperComparisonCallback(BaseCallback):
     def _on_training_start(self) -> None:
         setup = episode_setup(self.env_id, self.env_kwargs)
         paper_trigger = setup.make_policy("paper", {})
-        setup.env.close()
         if self.decisions is not None:
-            self._deployment = deployment(self.env_id, self.env_kwargs, self.decisions)
+            self._deployment = deployment(setup, self.decisions)
+        setup.env.close()
         self.paper = set_summary(self._run(paper_trigger))
         self._next_evaluation = self.num_timesteps + self.every
         self._started = time.perf_counter()

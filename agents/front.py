@@ -29,21 +29,21 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-Cost = Callable[[dict[str, Any]], float]
+Axes = Callable[[dict[str, Any]], tuple[float, float] | None]
+"""A point's (transmissions, mean cost) on one scenario set, ``None`` where it failed there."""
 
 
-def _set_mean(value: Any) -> float:
-    """A point's value on the scenario set: the mean of an aggregate (or the number itself)."""
-    return float(value["mean"]) if isinstance(value, dict) else float(value)
-
-
-def set_axes(point: dict[str, Any]) -> tuple[float, float]:
-    """(transmissions, mean cost) of a point on the scenario set (means over its scenarios)."""
-    return _set_mean(point["transmissions"]), _set_mean(point["mean_cost"])
+def set_axes(point: dict[str, Any]) -> tuple[float, float] | None:
+    """(transmissions, mean cost) of a point on the scenario set (means over its scenarios),
+    ``None`` if it failed on any of them."""
+    if point.get("failures"):
+        return None
+    return float(point["transmissions"]["mean"]), float(point["mean_cost"]["mean"])
 
 
 def paper_scenario_axes(point: dict[str, Any]) -> tuple[float, float] | None:
-    """(transmissions, mean cost) of a point's paper-scenario episode (``None``: not run)."""
+    """(transmissions, mean cost) of a point's paper-scenario episode (``None``: not run, or
+    failed)."""
     episode = point.get("paper_scenario")
     if episode is None or episode.get("failure") is not None:
         return None
@@ -113,7 +113,7 @@ def front_verdict(
     learned: list[dict[str, Any]],
     paper: list[dict[str, Any]],
     periodic: list[dict[str, Any]],
-    axes: Callable[[dict[str, Any]], tuple[float, float] | None] = set_axes,
+    axes: Axes = set_axes,
 ) -> dict[str, Any]:
     """The learned points' front against the paper sweep and the periodic sweep (points of
     :func:`agents.pareto.pareto`'s curves), on the axes ``axes`` reads (:func:`set_axes`, the
@@ -123,19 +123,11 @@ def front_verdict(
     :func:`compare` of each sweep (``paper``, ``periodic``) and ``met`` (both); ``ValueError``
     if the paper sweep has no failure-free point."""
 
-    def pairs(points: list[dict[str, Any]], on_set_failures: bool) -> list[tuple[float, float]]:
-        kept = []
-        for point in points:
-            if on_set_failures and point.get("failures"):
-                continue
-            pair = axes(point)
-            if pair is not None:
-                kept.append(pair)
-        return kept
+    def pairs(points: list[dict[str, Any]]) -> list[tuple[float, float]]:
+        return [pair for pair in map(axes, points) if pair is not None]
 
-    on_set = axes is set_axes
-    paper_pairs = pairs(paper, on_set)
-    learned_pairs = pairs(learned, on_set)
+    paper_pairs = pairs(paper)
+    learned_pairs = pairs(learned)
     if not paper_pairs:
         raise ValueError("the paper sweep has no failure-free point to span a range")
     span = (min(sent for sent, _ in paper_pairs), max(sent for sent, _ in paper_pairs))
@@ -150,7 +142,7 @@ def front_verdict(
         }
     against = {
         "paper": compare(learned_pairs, paper_pairs, span),
-        "periodic": compare(learned_pairs, pairs(periodic, on_set), span),
+        "periodic": compare(learned_pairs, pairs(periodic), span),
     }
     return {
         "range": list(span),

@@ -211,8 +211,8 @@ def test_a_stand_alone_trigger_takes_the_constant_decisions_actions(
     decision policy, one Python call per instant: the same transmissions, cost and return."""
     decisions = DecisionSet(env_id, **decision_keywords)
     seeds = scenario_set("validation", SET_SIZE).seeds
-    deployed = deployment(env_id, env_kwargs, decisions)
     setup = episode_setup(env_id, env_kwargs)
+    deployed = deployment(setup, decisions)
     for label in labels:
         action = decisions.action(label)
         assert stand_alone_spec(decisions, action) is not None
