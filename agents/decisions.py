@@ -3,16 +3,15 @@
 One step of :class:`SelfTriggeredWrapper` is one decision of :mod:`baselines.self_triggered`:
 hold 2^j instants after transmitting now, or hand the interval to the paper's trigger with its
 threshold scaled by f. The wrapper runs the interval on the unchanged env and returns the
-observation of the next decision instant. A hold's instants run in one compiled call
-(:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`) when only ``gym.make``'s
-order-enforcing and passive-checker wrappers lie between the wrapper and the loop env (neither
-acts on a step once the env is reset and its first step checked), and so does a "follow the
-paper" interval, whose rule's compiled kernel decides each instant inside the loop
-(:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_rule_interval`); under any other wrapper
-(``TimeLimit``, say) every instant goes through ``env.step``, the rule deciding in Python. Its
-reward is the interval's rewards discounted
-within it, ``sum_i gamma**i * r_i`` over the ``n`` instants it ran, and ``info["elapsed_steps"]
-= n``, so that an algorithm discounting the next decision by ``gamma**n`` keeps the meaning of
+observation of the next decision instant. The interval runs in one compiled call
+(:func:`~baselines.self_triggered.run_decision_interval`: a hold's instants, or a "follow the
+paper" interval whose rule's compiled kernel decides each instant inside the loop) when only
+``gym.make``'s order-enforcing and passive-checker wrappers lie between the wrapper and the
+loop env (neither acts on a step once the env is reset and its first step checked); under any
+other wrapper (``TimeLimit``, say) every instant goes through ``env.step``, the rule deciding
+in Python. Its reward is the interval's rewards discounted within it, ``sum_i gamma**i *
+r_i`` over the ``n`` instants it ran, and ``info["elapsed_steps"] = n``, so that an algorithm
+discounting the next decision by ``gamma**n`` keeps the meaning of
 the per-instant return: Stable-Baselines3 discounts every decision by one constant ``gamma``
 unless it trains with the buffers and callback of :mod:`agents.elapsed_discount` and the same
 ``gamma`` as the wrapper's. ``action_masks()`` gives the
@@ -38,6 +37,7 @@ from baselines.self_triggered import (
     DEFAULT_MAX_EXPONENT,
     DecisionSet,
     IntervalSchedule,
+    run_decision_interval,
 )
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.validation import require_discount
@@ -76,7 +76,8 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             (the rule paired with a heartbeat of ``rule_cap`` instants).
         rule: the family of the rule actions, ``paper`` or ``error_time``
             (:class:`~baselines.self_triggered.DecisionSet`).
-        rule_floor: the floor of "paper × f, floor F" actions in instants, or ``None``.
+        rule_floor: the floor of "paper × f, floor F" actions in instants, one floor per
+            factor (a list), or ``None``.
     """
 
     def __init__(
@@ -89,7 +90,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         rule_cap: int | None = None,
         rule_heartbeat: bool = False,
         rule: str = "paper",
-        rule_floor: int | None = None,
+        rule_floor: int | list[int] | tuple[int, ...] | None = None,
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -147,13 +148,9 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         given = self.decisions.require_action(action)
         obs = self._observation[None]
         chosen = self.schedule.shielded(np.array([given]), obs)
-        following = int(chosen[0]) - self.decisions.n_holds
-        if following >= 0 and self._loop is not None:
-            observation, total, terminated, truncated, info, steps = self._loop.run_rule_interval(
-                self.schedule.triggers[following],
-                self.decisions.rule_steps,
-                self.gamma,
-                send_first=self.decisions.rule_sends_first,
+        if self._loop is not None:
+            observation, total, terminated, truncated, info, steps = run_decision_interval(
+                self._loop, self.schedule, int(chosen[0]), self._observation, self.gamma
             )
         else:
             observation, total, terminated, truncated, info, steps = self._run_schedule(chosen)
@@ -170,8 +167,9 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self, chosen: np.ndarray
     ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
         """The interval of action ``chosen`` (one row) instant by instant through
-        :class:`~baselines.self_triggered.IntervalSchedule`, its holds in compiled calls where
-        :func:`interval_env` allows: :meth:`_run`'s return over the whole interval."""
+        :class:`~baselines.self_triggered.IntervalSchedule` and ``env.step`` (where
+        :func:`interval_env` finds no loop env to run it in compiled calls): :meth:`_run`'s
+        return over the whole interval."""
         obs = self._observation[None]
         state = self.schedule.start(chosen)
         total, steps = 0.0, 0
@@ -191,11 +189,9 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def _run(
         self, first_action: np.ndarray, instants: int
     ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
-        """``first_action`` then holds, for ``instants`` instants or to the episode's end:
-        ``(observation, sum_k gamma**k * reward_k, terminated, truncated, info, instants run)``
-        (in one compiled call where :func:`interval_env` allows it)."""
-        if instants > 1 and self._loop is not None:
-            return self._loop.run_interval(first_action, instants, self.gamma)
+        """``first_action`` then holds, for ``instants`` instants or to the episode's end,
+        through ``env.step``: ``(observation, sum_k gamma**k * reward_k, terminated, truncated,
+        info, instants run)``."""
         action, total = first_action, 0.0
         for instant in range(instants):
             observation, reward, terminated, truncated, info = self.env.step(action)

@@ -71,7 +71,7 @@ class FollowerDecisionEnv(gym.Env):
         rule_cap: int | None = None,
         rule_heartbeat: bool = False,
         rule: str = "paper",
-        rule_floor: int | None = None,
+        rule_floor: int | list[int] | tuple[int, ...] | None = None,
         teammate_decision: str | None = None,
     ) -> None:
         if env_id not in etsc_envs.PETTINGZOO_ENV_IDS:

@@ -12,6 +12,14 @@ scenario's record here equals :func:`baselines.episodes.run_episode`'s (or
 ``wall_time_s`` differs: it is the batch's wall time divided by ``K``. ``tests/test_batch.py``
 compares the two paths for every id.
 
+A self-triggered model (:class:`~baselines.self_triggered.SelfTriggeredPolicy`, Gymnasium ids)
+runs decision by decision instead: the model is asked once per decision for the rows still
+running, and each row's interval (a hold, or a rule deciding until it fires) runs in one
+compiled call of its own sub-environment
+(:func:`~baselines.self_triggered.run_decision_interval`). The episode is the one the policy
+gives stepped instant by instant, so every record's metrics are equal; only ``return`` may
+differ in its last bits, summed interval by interval (``tests/test_batch.py``).
+
 A sub-environment whose episode fails before the horizon is left to the vector env's
 next-step autoreset and ignored from then on; the batch ends when every scenario has ended
 once (all together at the horizon unless they fail).
@@ -41,6 +49,7 @@ from gymnasium.vector import AutoresetMode
 
 import etsc_envs
 from baselines.episodes import instants_bar
+from baselines.self_triggered import SelfTriggeredPolicy, run_decision_interval
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.vector_env import available_cores
 from etsc_envs.triggers.base import RuleTrigger
@@ -171,6 +180,10 @@ def _run(
     if isinstance(policy, RuleTrigger):
         _run_rule(vector_env, policy, returns, multi_agent, progress, description)
         ended_metrics = [env.episode_metrics() for env in vector_env.envs]
+    elif isinstance(policy, SelfTriggeredPolicy) and not multi_agent:
+        ended_metrics = _run_decisions(
+            vector_env, policy, observations, returns, progress, description
+        )
     else:
         ended_metrics = _run_predict(
             vector_env, policy, observations, returns, agent_index, progress, description
@@ -225,6 +238,45 @@ def _run_rule(
         returns += channel_totals
     else:
         returns[:, 0] += totals
+
+
+def _run_decisions(
+    vector_env: Any,
+    policy: SelfTriggeredPolicy,
+    observations: np.ndarray,
+    returns: np.ndarray,
+    progress: bool,
+    description: str,
+) -> list[dict[str, Any]]:
+    """Every row's episode from ``observations`` (just after the reset) decision by decision:
+    one batched choice of the model for the rows still running, then each row's interval in one
+    compiled call of its own sub-environment
+    (:func:`~baselines.self_triggered.run_decision_interval`), the episode
+    :class:`~baselines.self_triggered.SelfTriggeredPolicy` runs instant by instant. Adds each
+    row's return to ``returns`` and returns each row's episode metrics."""
+    rows = vector_env.num_envs
+    loops = vector_env.envs
+    observations = np.array(observations)
+    running = np.ones(rows, dtype=bool)
+    ended_metrics: list[dict[str, Any]] = [{} for _ in range(rows)]
+    shown = 0
+    with instants_bar(loops[0].n_steps, progress, description) as bar:
+        while running.any():
+            deciding = np.flatnonzero(running)
+            actions = policy.choose(observations[deciding])
+            for row, action in zip(deciding, actions, strict=True):
+                observation, total, terminated, truncated, _, _ = run_decision_interval(
+                    loops[row], policy.schedule, int(action), observations[row]
+                )
+                observations[row] = observation
+                returns[row, 0] += total
+                if terminated or truncated:
+                    running[row] = False
+                    ended_metrics[row] = loops[row].episode_metrics()
+            furthest = max(loop.step_index for loop in loops)
+            bar.update(furthest - shown)
+            shown = furthest
+    return ended_metrics
 
 
 def _run_predict(

@@ -17,8 +17,9 @@ An action of :class:`DecisionSet` is one of
   fires or H instants after that transmission, so always choosing it is the rule paired with a
   heartbeat of H instants (:class:`~etsc_envs.triggers.base.HeartbeatPolicy`; on a
   multi-channel id, an instant at which the rule fires on some channel sends every channel).
-* **paper × f, floor F** (a set with ``rule_floor`` F): every channel transmits at the decision
-  instant, holds the next F - 1 instants, and from then on the rule decides; the interval ends
+* **paper × f, floor F** (a set with ``rule_floor`` F, or with one floor per factor): every
+  channel transmits at the decision instant, holds the next F - 1 instants, and from then on
+  the rule decides; the interval ends
   just before an instant at which it fires (or after ``rule_cap``). Always choosing it is the
   rule gating a clock: transmit when the rule fires and F instants have passed since the last
   transmission (:func:`~etsc_envs.triggers.base.floored_trigger_class`, a minimum inter-event
@@ -105,7 +106,8 @@ class DecisionSet:
             instant, making it "paper × f, heartbeat ``rule_cap``" (see the module's
             description).
         rule_floor: the floor F of "paper × f, floor F" actions (an integer in 1..2^20, at most
-            ``rule_cap``; needs ``sampling_period_s``), or ``None`` for none.
+            ``rule_cap``; needs ``sampling_period_s``), a list of one such floor per factor
+            (the rule actions then pair each factor with its own floor), or ``None`` for none.
         rule: the family of the rule actions (:data:`etsc_envs.triggers.RULE_FAMILIES`):
             ``paper`` (the paper's trigger) or ``error_time`` (the id's error-time rule, which
             the shield does not cover); it names them (``paper x2``, ``error_time x2``).
@@ -119,7 +121,7 @@ class DecisionSet:
     rule_cap: int | None = None
     rule_heartbeat: bool = False
     rule: str = "paper"
-    rule_floor: int | None = None
+    rule_floor: int | tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -139,11 +141,18 @@ class DecisionSet:
             raise ValueError(f"rule_cap must be an integer in 1..{2**20} or None, got {cap!r}")
         if not isinstance(self.rule_heartbeat, bool):
             raise ValueError(f"rule_heartbeat must be true or false, got {self.rule_heartbeat!r}")
-        floor = self.rule_floor
-        if floor is not None:
+        if isinstance(self.rule_floor, list | tuple):
+            if len(self.rule_floor) != len(factors):
+                raise ValueError(
+                    f"rule_floor: a list needs one floor per factor ({len(factors)}), got "
+                    f"{list(self.rule_floor)!r}"
+                )
+            object.__setattr__(self, "rule_floor", tuple(self.rule_floor))
+        for floor in () if self.rule_floor is None else self.floors:
             if isinstance(floor, bool) or not isinstance(floor, int) or not 1 <= floor <= 2**20:
                 raise ValueError(
-                    f"rule_floor must be an integer in 1..{2**20} or None, got {floor!r}"
+                    f"rule_floor must be an integer in 1..{2**20}, a list of them (one per "
+                    f"factor) or None, got {self.rule_floor!r}"
                 )
             if floor > self.rule_steps:
                 raise ValueError(
@@ -199,10 +208,18 @@ class DecisionSet:
         ``error_time x2``)."""
         if action < self.n_holds:
             return f"hold {int(self.hold_steps[action])}"
-        label = f"{self.rule} x{self.factors[action - self.n_holds]:g}"
-        if self.rule_floor is not None:
-            label = f"{label}, floor {self.rule_floor}"
+        index = action - self.n_holds
+        label = f"{self.rule} x{self.factors[index]:g}"
+        if self.floors[index] is not None:
+            label = f"{label}, floor {self.floors[index]}"
         return f"{label}, heartbeat {self.rule_steps}" if self.rule_heartbeat else label
+
+    @property
+    def floors(self) -> tuple[int | None, ...]:
+        """The floor of each rule action, in the order of ``factors`` (``None``: no floor)."""
+        if isinstance(self.rule_floor, tuple):
+            return self.rule_floor
+        return (self.rule_floor,) * len(self.factors)
 
     @property
     def rule_sends_first(self) -> bool:
@@ -296,11 +313,6 @@ class IntervalSchedule:
     ) -> None:
         self.decisions = decisions
         self.n_bits = transmit_bits(action_space)
-        floor_s = (
-            None
-            if decisions.rule_floor is None
-            else floor_seconds(decisions.rule_floor, decisions.sampling_period_s)
-        )
         self.triggers = [
             scaled_rule_trigger(
                 decisions.env_id,
@@ -309,9 +321,9 @@ class IntervalSchedule:
                 action_space,
                 observation_names,
                 decisions.rule,
-                floor_s,
+                None if floor is None else floor_seconds(floor, decisions.sampling_period_s),
             )
-            for factor in decisions.factors
+            for factor, floor in zip(decisions.factors, decisions.floors, strict=True)
         ]
         self.shield = (
             None
@@ -391,6 +403,34 @@ class IntervalSchedule:
         decision = self._rule_fires(obs, state)
         decision[first] = True
         return decision, state + np.array([0, 1])
+
+
+def run_decision_interval(
+    loop: Any,
+    schedule: IntervalSchedule,
+    action: int,
+    observation: np.ndarray,
+    gamma: float = 1.0,
+) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
+    """The interval of ``action``, chosen at the instant of ``observation``, in one compiled
+    call of ``loop`` (an :class:`~etsc_envs.core.loop_env.EventTriggeredEnv` at that instant):
+    a hold transmits as :meth:`IntervalSchedule.transmit` says and holds the rest of its
+    instants (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`), a rule action
+    lets its scaled trigger decide inside the loop until it fires again
+    (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_rule_interval`). The episode ends
+    as under :class:`SelfTriggeredPolicy` stepping the same instants one by one. Returns
+    ``(observation, sum_k gamma**k * reward_k, terminated, truncated, info, instants run)``."""
+    decisions = schedule.decisions
+    following = action - decisions.n_holds
+    if following >= 0:
+        return loop.run_rule_interval(
+            schedule.triggers[following],
+            decisions.rule_steps,
+            gamma,
+            send_first=decisions.rule_sends_first,
+        )
+    decision, _ = schedule.transmit(observation[None], schedule.start(np.array([action])))
+    return loop.run_interval(decision[0].astype(np.int64), int(decisions.hold_steps[action]), gamma)
 
 
 class SelfTriggeredPolicy:

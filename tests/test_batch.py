@@ -8,10 +8,13 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
+from agents.evaluation import deployment
 from baselines.batch import run_batch, run_batch_in_processes
 from baselines.cli import episode_setup
+from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
 
 SHORT_HORIZONS = {
     "etsc/AttitudeTracking-v0": 2.0,
@@ -142,3 +145,64 @@ def test_worker_processes_give_the_records_of_one_process(env_id: str, spec: str
 def test_a_bad_process_count_names_itself(processes: Any) -> None:
     with pytest.raises(ValueError, match="processes"):
         run_batch_in_processes("etsc/AttitudeTracking-v0", "paper", {}, SEEDS, processes=processes)
+
+
+class ScriptedDecisions:
+    """A stand-in for a self-triggered model: an action that varies with the observation."""
+
+    def __init__(self, n_actions: int) -> None:
+        self.n_actions = n_actions
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        digits = np.abs(np.asarray(observation)).sum(axis=1) * 1e4
+        return digits.astype(np.int64) % self.n_actions, None
+
+
+def assert_same_episode(single: dict[str, Any], batch: dict[str, Any]) -> None:
+    """Equal records but the return, which the decision path sums interval by interval."""
+    assert batch["return"] == pytest.approx(single["return"], rel=1e-12)
+    assert_same_record({**single, "return": 0.0}, {**batch, "return": 0.0})
+
+
+@pytest.mark.parametrize(
+    ("env_id", "decision_keywords"),
+    [
+        ("etsc/AttitudeTracking-v0", {"max_exponent": 6, "rule_cap": 48, "rule_heartbeat": True}),
+        ("etsc/InnerFormation-v0", {"max_exponent": 6, "shield_multiple": 2.0}),
+        ("etsc/InnerFormation-v0", {"max_exponent": 5, "rule": "error_time"}),
+        ("etsc/OrbitAttitudeTracking-v0", {"max_exponent": 6, "rule_floor": 8}),
+        ("etsc/AsteroidOrbitKeeping-v0", {"max_exponent": 6, "shield_multiple": 1.0}),
+        ("etsc/ClusterContainmentCentral-v0", {"max_exponent": 8}),
+    ],
+)
+def test_self_triggered_decisions_run_decision_by_decision_as_instant_by_instant(
+    env_id: str, decision_keywords: dict[str, Any]
+) -> None:
+    """run_batch runs a self-triggered policy's intervals in compiled calls, one choice per
+    decision: the episodes of the per-instant deployment, every action of the set taken."""
+    env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
+    setup = episode_setup(env_id, env_args)
+    unwrapped = setup.env.unwrapped
+    decisions = DecisionSet(
+        env_id, sampling_period_s=float(unwrapped.params.sampling_period_s), **decision_keywords
+    )
+    policy = SelfTriggeredPolicy(
+        ScriptedDecisions(decisions.action_space.n), *deployment(setup, decisions)
+    )
+    single = [setup.run(setup.env, policy, seed)[0] for seed in SEEDS]
+    setup.env.close()
+    batch = run_batch(env_id, policy, SEEDS, env_args)
+    assert len({distinct(record) for record in single}) == len(SEEDS), "scenarios must differ"
+    for one, other in zip(single, batch, strict=True):
+        assert_same_episode(one, other)
+
+
+def test_a_shipped_self_triggered_model_runs_decision_by_decision() -> None:
+    pytest.importorskip("stable_baselines3")
+    env_id = "etsc/AttitudeTracking-v0"
+    spec = f"sb3:{MODEL.with_name('AttitudeTracking-v0_self_triggered.zip')}"
+    env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
+    single = single_records(env_id, spec, {}, env_args)
+    batch = batch_records(env_id, spec, {}, env_args)
+    for one, other in zip(single, batch, strict=True):
+        assert_same_episode(one, other)

@@ -70,13 +70,20 @@ def test_a_floored_rule_is_the_clock_where_the_rule_always_fires():
     np.testing.assert_array_equal(np.diff(instants), 32)
 
 
-def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions():
-    """Always choosing "paper x4, floor 48" transmits at the decision instant and then exactly
-    where the stand-alone floored rule does (through compiled intervals)."""
-    kwargs = {"max_exponent": 8, "factors": (1.0, 4.0), "rule_floor": 48}
+@pytest.mark.parametrize("rule_floor", [48, [16, 48], (48, 16)])
+def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions(rule_floor):
+    """Always choosing "paper x4, floor 48" (the set's one floor, or the floor paired with x4)
+    transmits at the decision instant and then exactly where the stand-alone floored rule does
+    (through compiled intervals)."""
+    kwargs = {"max_exponent": 8, "factors": (1.0, 4.0), "rule_floor": rule_floor}
     base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
     wrapper = SelfTriggeredWrapper(base, **kwargs)
-    action = wrapper.decisions.action("paper x4, floor 48")
+    label = "paper x4, floor 48"
+    if rule_floor == (48, 16):
+        with pytest.raises(ValueError, match=label):
+            wrapper.decisions.action(label)
+        return
+    action = wrapper.decisions.action(label)
     wrapper.reset(seed=2)
     lengths, done = [], False
     while not done:
@@ -96,6 +103,9 @@ def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions():
         ({"rule_floor": 2.5}, "rule_floor must be an integer"),
         ({"rule_floor": 64, "max_exponent": 5}, r"rule_floor \(64\) must be at most"),
         ({"rule_floor": 8, "sampling_period_s": None}, "sampling_period_s"),
+        ({"factors": (1.0, 4.0), "rule_floor": [2]}, "one floor per factor"),
+        ({"factors": (1.0, 4.0), "rule_floor": [2, 0]}, "rule_floor must be an integer"),
+        ({"factors": (1.0, 4.0), "rule_floor": [2, None]}, "rule_floor must be an integer"),
         ({"env_id": FORMATION, "rule_floor": 8, "shield_multiple": 2.0}, "shield_multiple"),
     ],
 )
@@ -110,6 +120,11 @@ def test_the_floor_names_its_actions_and_bad_floors_name_themselves():
         ORBIT, factors=(4.0,), rule_floor=64, sampling_period_s=SAMPLING_PERIOD_S
     )
     assert decisions.label(decisions.n_holds) == "paper x4, floor 64"
+    paired = DecisionSet(
+        ORBIT, factors=(0.3, 1.0), rule_floor=[2, 8], sampling_period_s=SAMPLING_PERIOD_S
+    )
+    labels = [paired.label(paired.n_holds + index) for index in range(2)]
+    assert labels == ["paper x0.3, floor 2", "paper x1, floor 8"]
     env = gym.make(ORBIT, horizon_s=0.05)
     with pytest.raises(ValueError, match="floor_s"):
         floored_trigger_class(OrbitAttitudeTrigger)(
@@ -132,3 +147,12 @@ class ObservationLog:
         if self.first and len(self.observations) == 1:
             action = np.ones_like(action)
         return action, state
+
+
+def test_floors_per_factor_survive_a_save_and_a_load(tmp_path):
+    decisions = DecisionSet(
+        ORBIT, factors=(0.3, 1.0), rule_floor=[2, 8], sampling_period_s=SAMPLING_PERIOD_S
+    )
+    decisions.save(tmp_path / "model.zip")
+    loaded = DecisionSet.load(tmp_path / "model.zip")
+    assert loaded == decisions and loaded.floors == (2, 8)
