@@ -8,7 +8,8 @@ rows of ``docs/results.md``.
 For each scenario set (:mod:`etsc_envs.protocol`; default the paper scenario and the test set)
 it runs the paper's trigger, every ``--model`` (several models are training seeds of one
 method), and, for each model, periodic transmission at that model's own rate (every ``k``
-sampling instants on every channel, ``k`` matching the model's mean transmissions on the set).
+sampling instants on every channel, ``k`` matching the model's mean transmissions on the set;
+models at the same ``k``, such as the seeds of a pinned decision, share one run of it).
 All scenarios of a set run at once in the native vector env (:mod:`baselines.batch`).
 
 Per set and model it reports the paired per-scenario ratios with 95 % bootstrap intervals
@@ -173,12 +174,15 @@ def _compare_set(
     paper = run("paper")
     channels = channel_count(env_id, {**env_args, **paper["env_args"]})
     learned_rows = []
+    clocks: dict[int, dict[str, Any]] = {}  # one run per period: seeds often share their rate
     for model in models:
         learned = run(f"sb3:{model}")
         every = equal_rate_period(
             learned["mean"]["steps"], learned["mean"]["transmissions"], channels
         )
-        periodic = run("periodic", {"every": every})
+        if every not in clocks:
+            clocks[every] = run("periodic", {"every": every})
+        periodic = clocks[every]
         vs_paper = {
             key: paired_ratio(_column(learned, key), _column(paper, key))
             for key in ("mean_cost", "transmissions")

@@ -98,3 +98,28 @@ def test_a_learned_trigger_that_is_the_clock_is_a_tie(periodic_costs, tie, text)
     result = clock_verdict(paired_ratio(*map(np.array, costs)), learned, periodic)
     assert result["tie"] is tie
     assert verdict_text(result).startswith(text)
+
+
+def test_seeds_at_one_rate_share_one_run_of_the_clock(tmp_path: Path, monkeypatch) -> None:
+    """The clock at a period runs once per set (its episodes depend on the period alone): two
+    copies of one model, one clock run per set, and each row keeps the clock's records."""
+    import agents.results as results
+
+    calls = []
+    evaluate = results.evaluate
+
+    def counted(env_id, spec, **kwargs):
+        calls.append((spec, kwargs["scenarios"]))
+        return evaluate(env_id, spec, **kwargs)
+
+    monkeypatch.setattr(results, "evaluate", counted)
+    model = tiny_model(tmp_path / "model.zip", 0)
+    out_dir = tmp_path / "results"
+    argv = [ENV_ID, "--set-size", "4", "--out", str(out_dir), "--env-arg", "horizon_s=0.05"]
+    assert main([*argv, "--model", str(model), "--model", str(model)]) == 0
+    assert sorted(calls).count(("periodic", "test")) == 1
+    assert sorted(calls).count(("periodic", "paper")) == 1
+    test = json.loads((out_dir / "results.json").read_text(encoding="utf-8"))["sets"]["test"]
+    first, second = test["models"]
+    assert first["periodic_every"] == second["periodic_every"]
+    assert first["periodic"]["episodes"] == second["periodic"]["episodes"]
