@@ -34,7 +34,9 @@ class PerInstant:
         return self.policy.predict(*args, **kwargs)
 
 
-def timed(env_id: str, policy: Any, seeds: list[int], env_kwargs: dict[str, Any]) -> tuple:
+def timed(
+    env_id: str, policy: Any, seeds: list[int], env_kwargs: dict[str, Any]
+) -> tuple[float, list[tuple[float, float]]]:
     """Wall seconds of one batch, and its records' (transmissions, mean_cost) per scenario."""
     start = time.perf_counter()
     records = run_batch(env_id, policy, seeds, env_kwargs)

@@ -273,9 +273,10 @@ def _run_decisions(
                 if terminated or truncated:
                     running[row] = False
                     ended_metrics[row] = loops[row].episode_metrics()
-            furthest = max(loop.step_index for loop in loops)
-            bar.update(furthest - shown)
-            shown = furthest
+            if progress:
+                furthest = max(loop.step_index for loop in loops)
+                bar.update(furthest - shown)
+                shown = furthest
     return ended_metrics
 
 

@@ -19,11 +19,11 @@ An action of :class:`DecisionSet` is one of
   multi-channel id, an instant at which the rule fires on some channel sends every channel).
 * **paper × f, floor F** (a set with ``rule_floor`` F, or with one floor per factor): every
   channel transmits at the decision instant, holds the next F - 1 instants, and from then on
-  the rule decides; the interval ends
-  just before an instant at which it fires (or after ``rule_cap``). Always choosing it is the
-  rule gating a clock: transmit when the rule fires and F instants have passed since the last
-  transmission (:func:`~etsc_envs.triggers.base.floored_trigger_class`, a minimum inter-event
-  time; on a multi-channel id every channel transmits at the decision instant).
+  the rule decides; the interval ends just before an instant at which it fires (or after
+  ``rule_cap``). Always choosing it is the rule gating a clock: transmit when the rule fires
+  and F instants have passed since the last transmission
+  (:func:`~etsc_envs.triggers.base.floored_trigger_class`, a minimum inter-event time; on a
+  multi-channel id every channel transmits at the decision instant).
 
 A multi-channel id (``MultiBinary``: 004, the central cluster) shares one interval: a hold
 sends every channel, the paper's rule sends the channels it names. :class:`IntervalSchedule`
@@ -51,6 +51,7 @@ import numpy as np
 
 from baselines.policies import load_sb3, takes_action_masks
 from etsc_envs.core.files import atomic_write_text
+from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.triggers import PAPER_SHIELDS, PAPER_TRIGGERS, RULE_FAMILIES
 from etsc_envs.triggers.base import (
     batched_observations,
@@ -406,14 +407,14 @@ class IntervalSchedule:
 
 
 def run_decision_interval(
-    loop: Any,
+    loop: EventTriggeredEnv,
     schedule: IntervalSchedule,
     action: int,
     observation: np.ndarray,
     gamma: float = 1.0,
 ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any], int]:
     """The interval of ``action``, chosen at the instant of ``observation``, in one compiled
-    call of ``loop`` (an :class:`~etsc_envs.core.loop_env.EventTriggeredEnv` at that instant):
+    call of ``loop`` (the loop env, at that instant):
     a hold transmits as :meth:`IntervalSchedule.transmit` says and holds the rest of its
     instants (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_interval`), a rule action
     lets its scaled trigger decide inside the loop until it fires again
