@@ -71,9 +71,11 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             :data:`etsc_envs.triggers.PAPER_SHIELDS`).
         gamma: the per-instant discount within an interval (in (0, 1]); the algorithm's
             ``gamma`` when it discounts by elapsed instants.
-        rule_cap: the longest "paper × f" interval in instants (``None``: 2^max_exponent).
+        rule_cap: the longest "paper × f" interval in instants, or one per factor (a list;
+            ``None``: 2^max_exponent).
         rule_heartbeat: whether "paper × f" intervals transmit at their decision instant
-            (the rule paired with a heartbeat of ``rule_cap`` instants).
+            (the rule paired with a heartbeat of ``rule_cap`` instants, its factor's own where
+            it is a list).
         rule: the family of the rule actions, ``paper`` or ``error_time``
             (:class:`~baselines.self_triggered.DecisionSet`).
         rule_floor: the floor of "paper × f, floor F" actions in instants, one floor per

@@ -38,8 +38,14 @@ from baselines.self_triggered import (
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.validation import require_discount
 
-DEFAULT_TEAMMATE_DECISION = "paper x1"
-"""The teammates' decision until :meth:`FollowerDecisionEnv.follow_model`: the paper's rule."""
+
+def default_teammate_action(decisions: DecisionSet) -> int:
+    """The teammates' decision until :meth:`FollowerDecisionEnv.follow_model` when none is
+    named: the rule action at the paper's own threshold (factor 1, with the set's heartbeat or
+    floor where it pairs one), else the set's first rule action, else hold 1."""
+    factors = decisions.factors
+    index = factors.index(1.0) if 1.0 in factors else 0
+    return decisions.n_holds + index if factors else 0
 
 
 class FollowerDecisionEnv(gym.Env):
@@ -55,7 +61,7 @@ class FollowerDecisionEnv(gym.Env):
             default).
         gamma: the per-instant discount within an interval (in (0, 1]).
         teammate_decision: the label of the teammates' decision until :meth:`follow_model`
-            (``None``: :data:`DEFAULT_TEAMMATE_DECISION`).
+            (``None``: :func:`default_teammate_action`).
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
@@ -107,7 +113,11 @@ class FollowerDecisionEnv(gym.Env):
         self.action_space = self.decisions.action_space
         self.n_agents = len(self.parallel_env.possible_agents)
         self.teammates = SelfTriggeredPolicy(
-            FixedDecision(self.decisions.action(teammate_decision or DEFAULT_TEAMMATE_DECISION)),
+            FixedDecision(
+                default_teammate_action(self.decisions)
+                if teammate_decision is None
+                else self.decisions.action(teammate_decision)
+            ),
             self.schedule,
             agent_observations,
             agent_actions,

@@ -8,11 +8,13 @@ An action of :class:`DecisionSet` is one of
 * **paper × f**: the paper's trigger with its threshold keywords
   (:data:`etsc_envs.triggers.PAPER_THRESHOLDS`) scaled by f decides every instant, the
   decision instant included; the interval ends just before a later instant at which it fires
-  (on any channel), after 2^k instants (or the set's ``rule_cap``), or with the episode.
+  (on any channel), after 2^k instants (or the set's ``rule_cap``, which may give each factor
+  its own), or with the episode.
   Always choosing f = 1 is the paper's trigger. A set whose ``rule`` is ``error_time`` offers
   the id's error-time rule (:data:`etsc_envs.triggers.ERROR_TIME_TRIGGERS`) the same way,
   labelled **error_time × f**.
-* **paper × f, heartbeat H** (a set with ``rule_heartbeat``, H its ``rule_cap``): as paper × f,
+* **paper × f, heartbeat H** (a set with ``rule_heartbeat``, H its ``rule_cap``, or the factor's
+  own cap where ``rule_cap`` is a list): as paper × f,
   but every channel transmits at the decision instant. The interval ends just before the rule
   fires or H instants after that transmission, so always choosing it is the rule paired with a
   heartbeat of H instants (:class:`~etsc_envs.triggers.base.HeartbeatPolicy`; on a
@@ -101,8 +103,9 @@ class DecisionSet:
             ``None`` for no shield.
         sampling_period_s: the env's sampling period (s), which the shield converts holds
             with; needed with ``shield_multiple``.
-        rule_cap: the longest "paper × f" interval in instants (an integer in 1..2^20), or
-            ``None`` for 2^k.
+        rule_cap: the longest "paper × f" interval in instants (an integer in 1..2^20), a
+            list of one such cap per factor (with ``rule_heartbeat``, a heartbeat per factor),
+            or ``None`` for 2^k.
         rule_heartbeat: whether a "paper × f" interval transmits every channel at its decision
             instant, making it "paper × f, heartbeat ``rule_cap``" (see the module's
             description).
@@ -119,7 +122,7 @@ class DecisionSet:
     factors: tuple[float, ...] | None = None
     shield_multiple: float | None = None
     sampling_period_s: float | None = None
-    rule_cap: int | None = None
+    rule_cap: int | tuple[int, ...] | None = None
     rule_heartbeat: bool = False
     rule: str = "paper"
     rule_floor: int | tuple[int, ...] | None = None
@@ -135,30 +138,27 @@ class DecisionSet:
         if not all(np.isfinite(f) and f > 0.0 for f in factors):
             raise ValueError(f"factors must be finite numbers > 0, got {self.factors!r}")
         object.__setattr__(self, "factors", factors)
-        cap = self.rule_cap
-        if cap is not None and (
-            isinstance(cap, bool) or not isinstance(cap, int) or not 1 <= cap <= 2**20
-        ):
-            raise ValueError(f"rule_cap must be an integer in 1..{2**20} or None, got {cap!r}")
+        self._per_factor("rule_cap", "cap", len(factors))
+        for cap in () if self.rule_cap is None else self.caps:
+            if isinstance(cap, bool) or not isinstance(cap, int) or not 1 <= cap <= 2**20:
+                raise ValueError(
+                    f"rule_cap must be an integer in 1..{2**20}, a list of them (one per "
+                    f"factor) or None, got {self.rule_cap!r}"
+                )
         if not isinstance(self.rule_heartbeat, bool):
             raise ValueError(f"rule_heartbeat must be true or false, got {self.rule_heartbeat!r}")
-        if isinstance(self.rule_floor, list | tuple):
-            if len(self.rule_floor) != len(factors):
-                raise ValueError(
-                    f"rule_floor: a list needs one floor per factor ({len(factors)}), got "
-                    f"{list(self.rule_floor)!r}"
-                )
-            object.__setattr__(self, "rule_floor", tuple(self.rule_floor))
-        for floor in () if self.rule_floor is None else self.floors:
+        self._per_factor("rule_floor", "floor", len(factors))
+        floored = () if self.rule_floor is None else zip(self.floors, self.caps, strict=True)
+        for floor, cap in floored:
             if isinstance(floor, bool) or not isinstance(floor, int) or not 1 <= floor <= 2**20:
                 raise ValueError(
                     f"rule_floor must be an integer in 1..{2**20}, a list of them (one per "
                     f"factor) or None, got {self.rule_floor!r}"
                 )
-            if floor > self.rule_steps:
+            if floor > cap:
                 raise ValueError(
-                    f"rule_floor ({floor}) must be at most the longest rule interval "
-                    f"({self.rule_steps}: rule_cap, else 2^max_exponent)"
+                    f"rule_floor ({floor}) must be at most its factor's longest rule interval "
+                    f"({cap}: rule_cap, else 2^max_exponent)"
                 )
             if self.sampling_period_s is None:
                 raise ValueError("sampling_period_s must be given with rule_floor")
@@ -185,15 +185,31 @@ class DecisionSet:
         if self.sampling_period_s is None:
             raise ValueError("sampling_period_s must be given with shield_multiple")
 
+    def _per_factor(self, name: str, entry: str, n_factors: int) -> None:
+        """Store the keyword ``name`` as a tuple if it is a list, which needs one ``entry`` per
+        factor."""
+        value = getattr(self, name)
+        if isinstance(value, list | tuple):
+            if len(value) != n_factors:
+                raise ValueError(
+                    f"{name}: a list needs one {entry} per factor ({n_factors}), got "
+                    f"{list(value)!r}"
+                )
+            object.__setattr__(self, name, tuple(value))
+
     @property
     def hold_steps(self) -> np.ndarray:
         """Sampling instants of each hold action: 1, 2, 4, ..., 2^k."""
         return 2 ** np.arange(self.max_exponent + 1)
 
     @property
-    def rule_steps(self) -> int:
-        """The longest "paper × f" interval in instants: ``rule_cap``, else 2^k."""
-        return int(self.hold_steps[-1]) if self.rule_cap is None else self.rule_cap
+    def caps(self) -> tuple[int, ...]:
+        """The longest interval of each rule action in instants, in the order of ``factors``:
+        its ``rule_cap``, else 2^k."""
+        if isinstance(self.rule_cap, tuple):
+            return self.rule_cap
+        cap = int(self.hold_steps[-1]) if self.rule_cap is None else self.rule_cap
+        return (cap,) * len(self.factors)
 
     @property
     def n_holds(self) -> int:
@@ -213,7 +229,7 @@ class DecisionSet:
         label = f"{self.rule} x{self.factors[index]:g}"
         if self.floors[index] is not None:
             label = f"{label}, floor {self.floors[index]}"
-        return f"{label}, heartbeat {self.rule_steps}" if self.rule_heartbeat else label
+        return f"{label}, heartbeat {self.caps[index]}" if self.rule_heartbeat else label
 
     @property
     def floors(self) -> tuple[int | None, ...]:
@@ -382,10 +398,12 @@ class IntervalSchedule:
         action, elapsed = state[:, 0], state[:, 1]
         holding = action < decisions.n_holds
         hold_length = decisions.hold_steps[np.minimum(action, decisions.n_holds - 1)]
+        caps = np.array((*decisions.caps, 0))  # padded: a set may have no rule action
+        cap = caps[np.clip(action - decisions.n_holds, 0, len(decisions.caps))]
         fires = self._rule_fires(obs, state)
         if fires.ndim == 2:
             fires = fires.any(axis=1)
-        rule_over = (elapsed >= decisions.rule_steps) | ((elapsed >= 1) & fires)
+        rule_over = (elapsed >= cap) | ((elapsed >= 1) & fires)
         return np.where(holding, elapsed >= hold_length, rule_over)
 
     def unconditional_holds(self, state: np.ndarray) -> np.ndarray:
@@ -426,7 +444,7 @@ def run_decision_interval(
     if following >= 0:
         return loop.run_rule_interval(
             schedule.triggers[following],
-            decisions.rule_steps,
+            decisions.caps[following],
             gamma,
             send_first=decisions.rule_sends_first,
         )

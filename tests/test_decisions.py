@@ -164,7 +164,7 @@ def test_a_rule_cap_ends_follow_the_paper_intervals(rule_cap):
     compiled path and instant by instant alike, and the deployed policy takes the same
     transmit/hold actions."""
     decisions = DecisionSet(ATTITUDE, max_exponent=3, factors=(64.0,), rule_cap=rule_cap)
-    assert decisions.rule_steps == rule_cap
+    assert decisions.caps == (rule_cap,)
     follow = ScriptedModel(0, fixed=decisions.n_holds)
     kwargs = {"max_exponent": 3, "factors": (64.0,), "rule_cap": rule_cap}
     compiled = decision_episode(gym.make(ATTITUDE, horizon_s=HORIZON_S), follow, **kwargs)
@@ -207,6 +207,66 @@ def test_the_heartbeat_action_is_the_rule_paired_with_a_heartbeat(env_id, factor
     sent = np.flatnonzero(np.array(actions).reshape(len(actions), -1).any(axis=1))
     assert sent[0] == 0 and np.diff(sent).max() <= heartbeat
     assert len(sent) > len(actions) / heartbeat  # the rule fires between beats too
+
+
+def test_a_cap_per_factor_ends_each_rule_interval_at_its_own_cap():
+    """With ``rule_cap`` a list, each "follow the paper" action's interval lasts at most its own
+    factor's cap, in the compiled path and instant by instant alike, and the deployed policy
+    takes the same transmit/hold actions."""
+    kwargs = {"max_exponent": 3, "factors": (64.0, 64.0), "rule_cap": [5, 24]}
+    decisions = DecisionSet(ATTITUDE, **kwargs)
+    assert decisions.caps == (5, 24)
+    for index, cap in enumerate(decisions.caps):
+        follow = ScriptedModel(0, fixed=decisions.n_holds + index)
+        compiled = decision_episode(gym.make(ATTITUDE, horizon_s=HORIZON_S), follow, **kwargs)
+        actions, infos = wrapper_actions(ATTITUDE, follow, **kwargs)
+        elapsed = [info["elapsed_steps"] for info in infos[:-1]]
+        assert max(elapsed) == cap
+        assert [result[4]["elapsed_steps"] for result in compiled[:-1]] == elapsed
+        assert_same(actions, policy_actions(ATTITUDE, deployed(ATTITUDE, follow, **kwargs)))
+
+
+def test_a_heartbeat_per_factor_pairs_each_factor_with_its_own():
+    """With ``rule_heartbeat`` and ``rule_cap`` a list, always choosing a rule action takes the
+    actions of :class:`HeartbeatPolicy` over the rule at its factor with its factor's heartbeat,
+    and the labels name each pair; the set round-trips through its file."""
+    from etsc_envs.triggers.base import HeartbeatPolicy
+
+    kwargs = {"max_exponent": 3, "factors": (16.0, 2.0), "rule_cap": [12, 40]}
+    decisions = DecisionSet(ATTITUDE, **kwargs, rule_heartbeat=True)
+    labels = [decisions.label(decisions.n_holds + index) for index in range(2)]
+    assert labels == ["paper x16, heartbeat 12", "paper x2, heartbeat 40"]
+    env = gym.make(ATTITUDE, horizon_s=HORIZON_S)
+    for index, (factor, heartbeat) in enumerate(
+        zip(decisions.factors, decisions.caps, strict=True)
+    ):
+        follow = ScriptedModel(0, fixed=decisions.n_holds + index)
+        actions, _ = wrapper_actions(ATTITUDE, follow, **kwargs, rule_heartbeat=True)
+        rule = PAPER_TRIGGERS[ATTITUDE](
+            env.observation_space,
+            env.action_space,
+            env.unwrapped.observation_names,
+            **{name: factor * value for name, value in PAPER_THRESHOLDS[ATTITUDE]().items()},
+        )
+        assert_same(actions, policy_actions(ATTITUDE, HeartbeatPolicy(rule, heartbeat)))
+
+
+def test_a_cap_list_round_trips_and_bad_lists_name_themselves(tmp_path):
+    decisions = DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12, 40], rule_heartbeat=True)
+    decisions.save(tmp_path / "model.zip")
+    assert DecisionSet.load(tmp_path / "model.zip") == decisions
+    with pytest.raises(ValueError, match="one cap per factor"):
+        DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12])
+    with pytest.raises(ValueError, match="rule_cap must be an integer"):
+        DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12, 0])
+    with pytest.raises(ValueError, match=r"rule_floor \(16\) must be at most its factor's"):
+        DecisionSet(
+            "etsc/OrbitAttitudeTracking-v0",
+            factors=(1.0, 2.0),
+            rule_cap=[64, 8],
+            rule_floor=16,
+            sampling_period_s=0.001,
+        )
 
 
 def test_a_time_limit_sees_every_instant_of_a_hold():

@@ -14,6 +14,7 @@ from agents.follower_decisions import FollowerDecisionEnv
 from baselines.episodes import run_parallel_episode
 from baselines.self_triggered import SelfTriggeredPolicy
 from etsc_envs.triggers import PAPER_TRIGGERS
+from etsc_envs.triggers.base import HeartbeatPolicy
 
 CLUSTER = "etsc/ClusterContainment-v0"
 HORIZON_S = 3.0
@@ -106,6 +107,36 @@ def test_teammates_take_the_fixed_decision_until_they_follow_a_model():
             info["episode_metrics"]["agents"][name]["transmissions"]
             == record["agents"][name]["transmissions"]
         )
+
+
+def test_a_heartbeat_per_factor_is_each_followers_rule_with_its_own_heartbeat():
+    """A set pairing each factor with its own heartbeat (``rule_cap`` a list): the teammates'
+    default decision is the paper's rule with its heartbeat, and with the learner taking it
+    too each follower updates as eq. (15)'s rule with a heartbeat of its own does alone."""
+    env = follower_env(
+        horizon_s=20.0, factors=(1.0, 1.5), rule_cap=[256, 1024], rule_heartbeat=True
+    )
+    assert env.decisions.label(env.teammates.model.action) == "paper x1, heartbeat 256"
+    env.reset(seed=2)
+    while True:
+        _, _, terminated, truncated, info = env.step(env.teammates.model.action)
+        if terminated or truncated:
+            break
+    parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=20.0)
+    agent = parallel.possible_agents[0]
+    paper = PAPER_TRIGGERS[CLUSTER](
+        parallel.observation_space(agent),
+        parallel.action_space(agent),
+        parallel.unwrapped.agent_observation_names,
+    )
+    record, _ = run_parallel_episode(parallel, HeartbeatPolicy(paper, 256), seed=2)
+    assert record["transmissions"] > len(parallel.possible_agents) * 2000 // 256
+    for name in parallel.possible_agents:
+        assert (
+            info["episode_metrics"]["agents"][name]["transmissions"]
+            == record["agents"][name]["transmissions"]
+        )
+    assert info["episode_metrics"]["mean_cost"] == record["mean_cost"]
 
 
 def test_follower_env_passes_the_gymnasium_and_sb3_env_checkers():
