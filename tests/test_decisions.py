@@ -158,21 +158,25 @@ def test_compiled_holds_equal_the_per_instant_path(env_id, shield):
         np.testing.assert_equal(list(got[1:]), list(expected[1:]))
 
 
-@pytest.mark.parametrize("rule_cap", [5, 24])
-def test_a_rule_cap_ends_follow_the_paper_intervals(rule_cap):
-    """With ``rule_cap`` a "follow the paper" interval lasts at most that many instants, in the
-    compiled path and instant by instant alike, and the deployed policy takes the same
-    transmit/hold actions."""
-    decisions = DecisionSet(ATTITUDE, max_exponent=3, factors=(64.0,), rule_cap=rule_cap)
-    assert decisions.caps == (rule_cap,)
-    follow = ScriptedModel(0, fixed=decisions.n_holds)
-    kwargs = {"max_exponent": 3, "factors": (64.0,), "rule_cap": rule_cap}
-    compiled = decision_episode(gym.make(ATTITUDE, horizon_s=HORIZON_S), follow, **kwargs)
-    actions, infos = wrapper_actions(ATTITUDE, follow, **kwargs)
-    elapsed = [info["elapsed_steps"] for info in infos[:-1]]
-    assert max(elapsed) == rule_cap
-    assert [result[4]["elapsed_steps"] for result in compiled[:-1]] == elapsed
-    assert_same(actions, policy_actions(ATTITUDE, deployed(ATTITUDE, follow, **kwargs)))
+@pytest.mark.parametrize(
+    ("factors", "rule_cap"), [((64.0,), 5), ((64.0,), 24), ((64.0, 64.0), [5, 24])]
+)
+def test_a_rule_cap_ends_follow_the_paper_intervals(factors, rule_cap):
+    """With ``rule_cap`` (one, or one per factor) a "follow the paper" interval lasts at most
+    its factor's cap, in the compiled path and instant by instant alike, and the deployed
+    policy takes the same transmit/hold actions."""
+    kwargs = {"max_exponent": 3, "factors": factors, "rule_cap": rule_cap}
+    decisions = DecisionSet(ATTITUDE, **kwargs)
+    caps = tuple(rule_cap) if isinstance(rule_cap, list) else (rule_cap,) * len(factors)
+    assert decisions.caps == caps
+    for index, cap in enumerate(caps):
+        follow = ScriptedModel(0, fixed=decisions.n_holds + index)
+        compiled = decision_episode(gym.make(ATTITUDE, horizon_s=HORIZON_S), follow, **kwargs)
+        actions, infos = wrapper_actions(ATTITUDE, follow, **kwargs)
+        elapsed = [info["elapsed_steps"] for info in infos[:-1]]
+        assert max(elapsed) == cap
+        assert [result[4]["elapsed_steps"] for result in compiled[:-1]] == elapsed
+        assert_same(actions, policy_actions(ATTITUDE, deployed(ATTITUDE, follow, **kwargs)))
 
 
 @pytest.mark.parametrize(
@@ -207,23 +211,6 @@ def test_the_heartbeat_action_is_the_rule_paired_with_a_heartbeat(env_id, factor
     sent = np.flatnonzero(np.array(actions).reshape(len(actions), -1).any(axis=1))
     assert sent[0] == 0 and np.diff(sent).max() <= heartbeat
     assert len(sent) > len(actions) / heartbeat  # the rule fires between beats too
-
-
-def test_a_cap_per_factor_ends_each_rule_interval_at_its_own_cap():
-    """With ``rule_cap`` a list, each "follow the paper" action's interval lasts at most its own
-    factor's cap, in the compiled path and instant by instant alike, and the deployed policy
-    takes the same transmit/hold actions."""
-    kwargs = {"max_exponent": 3, "factors": (64.0, 64.0), "rule_cap": [5, 24]}
-    decisions = DecisionSet(ATTITUDE, **kwargs)
-    assert decisions.caps == (5, 24)
-    for index, cap in enumerate(decisions.caps):
-        follow = ScriptedModel(0, fixed=decisions.n_holds + index)
-        compiled = decision_episode(gym.make(ATTITUDE, horizon_s=HORIZON_S), follow, **kwargs)
-        actions, infos = wrapper_actions(ATTITUDE, follow, **kwargs)
-        elapsed = [info["elapsed_steps"] for info in infos[:-1]]
-        assert max(elapsed) == cap
-        assert [result[4]["elapsed_steps"] for result in compiled[:-1]] == elapsed
-        assert_same(actions, policy_actions(ATTITUDE, deployed(ATTITUDE, follow, **kwargs)))
 
 
 def test_a_heartbeat_per_factor_pairs_each_factor_with_its_own():

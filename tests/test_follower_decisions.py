@@ -81,32 +81,46 @@ def test_every_follower_is_the_learner_under_some_seed():
     assert env.reset(seed=7)[1]["learner"] == env.reset(seed=7)[1]["learner"]
 
 
+def episode_info(env: FollowerDecisionEnv, action: int, seed: int) -> dict:
+    """The last ``info`` of an episode in which the learner takes ``action`` at every decision."""
+    env.reset(seed=seed)
+    while True:
+        _, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            return info
+
+
+def rule_alone(horizon_s: float, seed: int, heartbeat: int | None = None, **thresholds) -> dict:
+    """The record of eq. (15)'s rule run by every follower alone (with a heartbeat of its own
+    with ``heartbeat``)."""
+    parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=horizon_s)
+    agent = parallel.possible_agents[0]
+    rule = PAPER_TRIGGERS[CLUSTER](
+        parallel.observation_space(agent),
+        parallel.action_space(agent),
+        parallel.unwrapped.agent_observation_names,
+        **thresholds,
+    )
+    policy = rule if heartbeat is None else HeartbeatPolicy(rule, heartbeat)
+    record, _ = run_parallel_episode(parallel, policy, seed=seed)
+    return record
+
+
+def assert_same_updates(info: dict, record: dict) -> None:
+    """Every follower updates as often in the decision env's episode as in ``record``."""
+    for name, agent in record["agents"].items():
+        assert info["episode_metrics"]["agents"][name]["transmissions"] == agent["transmissions"]
+
+
 def test_teammates_take_the_fixed_decision_until_they_follow_a_model():
     """Before ``follow_model`` every teammate takes ``teammate_decision``: with the learner
     taking it too, each follower updates as eq. (15)'s rule at that c does alone (20 s: the
     rule first fires after a few seconds)."""
     env = follower_env(horizon_s=20.0, teammate_decision="paper x1.5")
-    env.reset(seed=2)
-    action = env.decisions.action("paper x1.5")
-    while True:
-        _, _, terminated, truncated, info = env.step(action)
-        if terminated or truncated:
-            break
-    parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=20.0)
-    agent = parallel.possible_agents[0]
-    paper = PAPER_TRIGGERS[CLUSTER](
-        parallel.observation_space(agent),
-        parallel.action_space(agent),
-        parallel.unwrapped.agent_observation_names,
-        c=0.9,  # 1.5 x the paper's c = 0.6
-    )
-    record, _ = run_parallel_episode(parallel, paper, seed=2)
+    info = episode_info(env, env.decisions.action("paper x1.5"), seed=2)
+    record = rule_alone(20.0, seed=2, c=0.9)  # 1.5 x the paper's c = 0.6
     assert record["transmissions"] > 0
-    for name in parallel.possible_agents:
-        assert (
-            info["episode_metrics"]["agents"][name]["transmissions"]
-            == record["agents"][name]["transmissions"]
-        )
+    assert_same_updates(info, record)
 
 
 def test_a_heartbeat_per_factor_is_each_followers_rule_with_its_own_heartbeat():
@@ -117,25 +131,10 @@ def test_a_heartbeat_per_factor_is_each_followers_rule_with_its_own_heartbeat():
         horizon_s=20.0, factors=(1.0, 1.5), rule_cap=[256, 1024], rule_heartbeat=True
     )
     assert env.decisions.label(env.teammates.model.action) == "paper x1, heartbeat 256"
-    env.reset(seed=2)
-    while True:
-        _, _, terminated, truncated, info = env.step(env.teammates.model.action)
-        if terminated or truncated:
-            break
-    parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=20.0)
-    agent = parallel.possible_agents[0]
-    paper = PAPER_TRIGGERS[CLUSTER](
-        parallel.observation_space(agent),
-        parallel.action_space(agent),
-        parallel.unwrapped.agent_observation_names,
-    )
-    record, _ = run_parallel_episode(parallel, HeartbeatPolicy(paper, 256), seed=2)
-    assert record["transmissions"] > len(parallel.possible_agents) * 2000 // 256
-    for name in parallel.possible_agents:
-        assert (
-            info["episode_metrics"]["agents"][name]["transmissions"]
-            == record["agents"][name]["transmissions"]
-        )
+    info = episode_info(env, env.teammates.model.action, seed=2)
+    record = rule_alone(20.0, seed=2, heartbeat=256)
+    assert record["transmissions"] > len(record["agents"]) * 2000 // 256
+    assert_same_updates(info, record)
     assert info["episode_metrics"]["mean_cost"] == record["mean_cost"]
 
 
