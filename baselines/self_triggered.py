@@ -139,7 +139,8 @@ class DecisionSet:
             raise ValueError(f"factors must be finite numbers > 0, got {self.factors!r}")
         object.__setattr__(self, "factors", factors)
         self._per_factor("rule_cap", "cap", len(factors))
-        for cap in () if self.rule_cap is None else self.caps:
+        given_caps = self.rule_cap if isinstance(self.rule_cap, tuple) else (self.rule_cap,)
+        for cap in () if self.rule_cap is None else given_caps:
             if isinstance(cap, bool) or not isinstance(cap, int) or not 1 <= cap <= 2**20:
                 raise ValueError(
                     f"rule_cap must be an integer in 1..{2**20}, a list of them (one per "

@@ -246,6 +246,8 @@ def test_a_cap_list_round_trips_and_bad_lists_name_themselves(tmp_path):
         DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12])
     with pytest.raises(ValueError, match="rule_cap must be an integer"):
         DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12, 0])
+    with pytest.raises(ValueError, match="rule_cap must be an integer"):
+        DecisionSet(ATTITUDE, factors=(), rule_cap=0)
     with pytest.raises(ValueError, match=r"rule_floor \(16\) must be at most its factor's"):
         DecisionSet(
             "etsc/OrbitAttitudeTracking-v0",
