@@ -331,6 +331,7 @@ class IntervalSchedule:
     ) -> None:
         self.decisions = decisions
         self.n_bits = transmit_bits(action_space)
+        self.rule_caps = np.array((*decisions.caps, 0))  # padded: a set may have no rule action
         self.triggers = [
             scaled_rule_trigger(
                 decisions.env_id,
@@ -399,8 +400,7 @@ class IntervalSchedule:
         action, elapsed = state[:, 0], state[:, 1]
         holding = action < decisions.n_holds
         hold_length = decisions.hold_steps[np.minimum(action, decisions.n_holds - 1)]
-        caps = np.array((*decisions.caps, 0))  # padded: a set may have no rule action
-        cap = caps[np.clip(action - decisions.n_holds, 0, len(decisions.caps))]
+        cap = self.rule_caps[np.clip(action - decisions.n_holds, 0, len(decisions.caps))]
         fires = self._rule_fires(obs, state)
         if fires.ndim == 2:
             fires = fires.any(axis=1)
