@@ -67,12 +67,13 @@ A config is a YAML mapping with these keys (the optional ones show their default
   training starts from the fixed decision exactly rather than from a fit of it;
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
-  ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``, ``rule_floor``; its ``gamma``
-  is ``hyperparameters.gamma``), on a ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
+  ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``, ``rule_floor``,
+  ``rule_channel_heartbeat``; its ``gamma`` is ``hyperparameters.gamma``), on a
+  ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
   :class:`agents.follower_decisions.FollowerDecisionEnv`; cloning with
-  ``imitation_decision``). PPO, A2C and MaskablePPO
-  then discount by elapsed instants (:mod:`agents.elapsed_discount`); the models are saved with
-  their decision set beside them, so that ``sb3:`` deploys them as transmit/hold policies;
+  ``imitation_decision``). PPO, A2C and MaskablePPO then discount by elapsed instants
+  (:mod:`agents.elapsed_discount`); the models are saved with their decision set beside
+  them, so that ``sb3:`` deploys them as transmit/hold policies;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
   batches of a few dozen rows run fastest on one thread; more threads contend with the
   vector env's stepping threads (twice the steps per second with one thread, measured on the
@@ -335,6 +336,7 @@ def _check_decisions(
         "rule_heartbeat",
         "rule",
         "rule_floor",
+        "rule_channel_heartbeat",
     )
     unknown = sorted(set(decisions) - set(allowed))
     if unknown:

@@ -55,7 +55,8 @@ def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str
     every N instants from the first (``periodic``, ``every=N``); "paper × f" without a
     heartbeat or a floor lets the rule at f times its threshold decide every instant, the
     decision instants included, and a capped interval hands over to the same rule (the rule
-    named by the set, its thresholds scaled). ``None`` for a rule action with a heartbeat or a
+    named by the set, its thresholds scaled, with the action's heartbeat per channel if it has
+    one: ``channel_heartbeat=H``). ``None`` for a rule action with a heartbeat or a
     floor (their stand-alone forms, where the suite has one, answer in Python every instant as
     the decision policy does, so there is nothing to gain) and for every action of a shielded
     set (the shield may replace a choice)."""
@@ -65,8 +66,12 @@ def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str
         return "periodic", {"every": int(decisions.hold_steps[action])}
     if decisions.rule_sends_first:
         return None
-    factor = decisions.factors[action - decisions.n_holds]
-    return decisions.rule, scaled_thresholds(decisions.env_id, factor, decisions.rule)
+    index = action - decisions.n_holds
+    arguments = scaled_thresholds(decisions.env_id, decisions.factors[index], decisions.rule)
+    channel_heartbeat = decisions.channel_heartbeats[index]
+    if channel_heartbeat is not None:
+        arguments["channel_heartbeat"] = channel_heartbeat
+    return decisions.rule, arguments
 
 
 def constant_decision_policy(

@@ -80,6 +80,8 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             (:class:`~baselines.self_triggered.DecisionSet`).
         rule_floor: the floor of "paper × f, floor F" actions in instants, one floor per
             factor (a list), or ``None``.
+        rule_channel_heartbeat: the heartbeat per channel of "paper × f, channel heartbeat H"
+            actions in instants, one per factor (a list, ``None`` for none), or ``None``.
     """
 
     def __init__(
@@ -93,6 +95,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         rule_heartbeat: bool = False,
         rule: str = "paper",
         rule_floor: int | list[int] | tuple[int, ...] | None = None,
+        rule_channel_heartbeat: int | list[int | None] | tuple[int | None, ...] | None = None,
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -104,6 +107,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule_heartbeat=rule_heartbeat,
             rule=rule,
             rule_floor=rule_floor,
+            rule_channel_heartbeat=rule_channel_heartbeat,
         )
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
@@ -120,6 +124,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule_heartbeat=rule_heartbeat,
             rule=rule,
             rule_floor=rule_floor,
+            rule_channel_heartbeat=rule_channel_heartbeat,
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names

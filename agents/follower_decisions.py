@@ -55,8 +55,8 @@ class FollowerDecisionEnv(gym.Env):
     Args:
         env_id: the PettingZoo id (:data:`etsc_envs.PETTINGZOO_ENV_IDS`).
         env_kwargs: its keyword arguments.
-        max_exponent, factors, shield_multiple, rule_cap, rule_heartbeat, rule, rule_floor: the
-            decision set's
+        max_exponent, factors, shield_multiple, rule_cap, rule_heartbeat, rule, rule_floor,
+            rule_channel_heartbeat: the decision set's
             (:class:`~baselines.self_triggered.DecisionSet`; ``factors`` ``None``: the id's
             default).
         gamma: the per-instant discount within an interval (in (0, 1]).
@@ -78,6 +78,7 @@ class FollowerDecisionEnv(gym.Env):
         rule_heartbeat: bool = False,
         rule: str = "paper",
         rule_floor: int | list[int] | tuple[int, ...] | None = None,
+        rule_channel_heartbeat: int | list[int | None] | tuple[int | None, ...] | None = None,
         teammate_decision: str | None = None,
     ) -> None:
         if env_id not in etsc_envs.PETTINGZOO_ENV_IDS:
@@ -102,6 +103,7 @@ class FollowerDecisionEnv(gym.Env):
             rule_heartbeat=rule_heartbeat,
             rule=rule,
             rule_floor=rule_floor,
+            rule_channel_heartbeat=rule_channel_heartbeat,
         )
         self.schedule = IntervalSchedule(
             self.decisions,

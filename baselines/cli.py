@@ -18,7 +18,12 @@ from etsc_envs.core.compiled_loop import always_accepts
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.triggers import RULE_FAMILIES, AlwaysPolicy, PeriodicPolicy
-from etsc_envs.triggers.base import ClockTrigger, HeartbeatPolicy
+from etsc_envs.triggers.base import (
+    ClockTrigger,
+    HeartbeatPolicy,
+    channel_heartbeat_trigger_class,
+    instants_seconds,
+)
 
 POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP"
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
@@ -198,7 +203,19 @@ def _policy_for(
         names = observation_names()
         arguments = dict(policy_args)
         heartbeat = arguments.pop("heartbeat", None)
-        trigger = triggers[env_id](observation_space, action_space, names, **arguments)
+        channel_heartbeat = arguments.pop("channel_heartbeat", None)
+        trigger_class = triggers[env_id]
+        if channel_heartbeat is not None:
+            if not isinstance(channel_heartbeat, int) or isinstance(channel_heartbeat, bool):
+                channel_heartbeat = 0
+            if channel_heartbeat < 1:
+                raise ValueError(
+                    f"--policy-arg channel_heartbeat must be an integer >= 1 (sampling "
+                    f"instants), got {policy_args['channel_heartbeat']!r}"
+                )
+            trigger_class = channel_heartbeat_trigger_class(trigger_class)
+            arguments["heartbeat_s"] = instants_seconds(channel_heartbeat, loop().sampling_period_s)
+        trigger = trigger_class(observation_space, action_space, names, **arguments)
         return trigger if heartbeat is None else HeartbeatPolicy(trigger, heartbeat)
     if spec.startswith("sb3:"):
         if policy_args:

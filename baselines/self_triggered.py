@@ -26,6 +26,13 @@ An action of :class:`DecisionSet` is one of
   and F instants have passed since the last transmission
   (:func:`~etsc_envs.triggers.base.floored_trigger_class`, a minimum inter-event time; on a
   multi-channel id every channel transmits at the decision instant).
+* **paper × f, channel heartbeat H** (a set with ``rule_channel_heartbeat``, one H per factor
+  or ``None`` for none): as paper × f, with the rule replaced by the rule paired with a
+  heartbeat per channel (:func:`~etsc_envs.triggers.base.channel_heartbeat_trigger_class`): a
+  channel also transmits once H instants have passed since its own last transmission, and
+  that sends it alone. Always choosing it is that trigger; on the central cluster it is the
+  trigger of the decentralised cluster's "paper × f, heartbeat H" run by every follower at
+  once.
 
 A multi-channel id (``MultiBinary``: 004, the central cluster) shares one interval: a hold
 sends every channel, the paper's rule sends the channels it names. :class:`IntervalSchedule`
@@ -57,8 +64,9 @@ from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.triggers import PAPER_SHIELDS, PAPER_TRIGGERS, RULE_FAMILIES
 from etsc_envs.triggers.base import (
     batched_observations,
-    floor_seconds,
+    channel_heartbeat_trigger_class,
     floored_trigger_class,
+    instants_seconds,
     transmit_bits,
 )
 
@@ -126,6 +134,7 @@ class DecisionSet:
     rule_heartbeat: bool = False
     rule: str = "paper"
     rule_floor: int | tuple[int, ...] | None = None
+    rule_channel_heartbeat: int | tuple[int | None, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -163,6 +172,26 @@ class DecisionSet:
                 )
             if self.sampling_period_s is None:
                 raise ValueError("sampling_period_s must be given with rule_floor")
+        self._per_factor("rule_channel_heartbeat", "heartbeat", len(factors))
+        given_heartbeats = () if self.rule_channel_heartbeat is None else self.channel_heartbeats
+        for heartbeat in given_heartbeats:
+            if heartbeat is None and isinstance(self.rule_channel_heartbeat, tuple):
+                continue
+            if not isinstance(heartbeat, int) or isinstance(heartbeat, bool):
+                heartbeat = -1
+            if not 1 <= heartbeat <= 2**20:
+                raise ValueError(
+                    f"rule_channel_heartbeat must be an integer in 1..{2**20}, a list of them "
+                    f"or None (one per factor) or None, got {self.rule_channel_heartbeat!r}"
+                )
+        if self.rule_channel_heartbeat is not None:
+            if self.rule_floor is not None:
+                raise ValueError(
+                    "rule_channel_heartbeat and rule_floor: a set takes one of the two, got "
+                    f"{self.rule_channel_heartbeat!r} and {self.rule_floor!r}"
+                )
+            if self.sampling_period_s is None:
+                raise ValueError("sampling_period_s must be given with rule_channel_heartbeat")
         if self.rule not in RULE_FAMILIES:
             raise ValueError(f"rule must be one of {sorted(RULE_FAMILIES)}, got {self.rule!r}")
         if self.env_id not in RULE_FAMILIES[self.rule][0]:
@@ -223,13 +252,15 @@ class DecisionSet:
 
     def label(self, action: int) -> str:
         """``action`` in words (``hold 8``, ``paper x2``, ``paper x2, heartbeat 384``,
-        ``error_time x2``)."""
+        ``paper x1, channel heartbeat 256``, ``error_time x2``)."""
         if action < self.n_holds:
             return f"hold {int(self.hold_steps[action])}"
         index = action - self.n_holds
         label = f"{self.rule} x{self.factors[index]:g}"
         if self.floors[index] is not None:
             label = f"{label}, floor {self.floors[index]}"
+        if self.channel_heartbeats[index] is not None:
+            label = f"{label}, channel heartbeat {self.channel_heartbeats[index]}"
         return f"{label}, heartbeat {self.caps[index]}" if self.rule_heartbeat else label
 
     @property
@@ -238,6 +269,14 @@ class DecisionSet:
         if isinstance(self.rule_floor, tuple):
             return self.rule_floor
         return (self.rule_floor,) * len(self.factors)
+
+    @property
+    def channel_heartbeats(self) -> tuple[int | None, ...]:
+        """The heartbeat per channel of each rule action, in the order of ``factors``
+        (``None``: none)."""
+        if isinstance(self.rule_channel_heartbeat, tuple):
+            return self.rule_channel_heartbeat
+        return (self.rule_channel_heartbeat,) * len(self.factors)
 
     @property
     def rule_sends_first(self) -> bool:
@@ -293,20 +332,28 @@ def scaled_rule_trigger(
     observation_names: tuple[str, ...],
     rule: str = "paper",
     floor_s: float | None = None,
+    heartbeat_s: float | None = None,
 ) -> Any:
     """The ``rule`` trigger of ``env_id`` (:data:`~etsc_envs.triggers.RULE_FAMILIES`) with its
-    threshold keywords scaled by ``factor``, with a floor of ``floor_s`` seconds if given
-    (:func:`~etsc_envs.triggers.base.floored_trigger_class`); ``ValueError`` naming ``factors``
-    when the scaled values leave the trigger's range."""
-    triggers = RULE_FAMILIES[rule][0]
-    scaled = scaled_thresholds(env_id, factor, rule)
+    threshold keywords scaled by ``factor``, with a floor of ``floor_s`` seconds
+    (:func:`~etsc_envs.triggers.base.floored_trigger_class`) or a heartbeat per channel of
+    ``heartbeat_s`` seconds (:func:`~etsc_envs.triggers.base.channel_heartbeat_trigger_class`)
+    if given (not both); ``ValueError`` naming ``factors`` when the scaled values leave the
+    trigger's range."""
+    if floor_s is not None and heartbeat_s is not None:
+        raise ValueError("floor_s and heartbeat_s: a rule takes one of the two")
+    trigger_class = RULE_FAMILIES[rule][0][env_id]
+    keywords = scaled_thresholds(env_id, factor, rule)
+    if floor_s is not None:
+        trigger_class, keywords = (
+            floored_trigger_class(trigger_class),
+            {**keywords, "floor_s": floor_s},
+        )
+    if heartbeat_s is not None:
+        trigger_class = channel_heartbeat_trigger_class(trigger_class)
+        keywords = {**keywords, "heartbeat_s": heartbeat_s}
     try:
-        if floor_s is not None:
-            floored = floored_trigger_class(triggers[env_id])
-            return floored(
-                observation_space, action_space, observation_names, floor_s=floor_s, **scaled
-            )
-        return triggers[env_id](observation_space, action_space, observation_names, **scaled)
+        return trigger_class(observation_space, action_space, observation_names, **keywords)
     except ValueError as error:
         raise ValueError(f"factors: {factor:g} x the {rule} rule's threshold: {error}") from None
 
@@ -332,6 +379,7 @@ class IntervalSchedule:
         self.decisions = decisions
         self.n_bits = transmit_bits(action_space)
         self.rule_caps = np.array((*decisions.caps, 0))  # padded: a set may have no rule action
+        period_s = decisions.sampling_period_s
         self.triggers = [
             scaled_rule_trigger(
                 decisions.env_id,
@@ -340,9 +388,14 @@ class IntervalSchedule:
                 action_space,
                 observation_names,
                 decisions.rule,
-                None if floor is None else floor_seconds(floor, decisions.sampling_period_s),
+                *(
+                    None if instants is None else instants_seconds(instants, period_s)
+                    for instants in (floor, heartbeat)
+                ),
             )
-            for factor, floor in zip(decisions.factors, decisions.floors, strict=True)
+            for factor, floor, heartbeat in zip(
+                decisions.factors, decisions.floors, decisions.channel_heartbeats, strict=True
+            )
         ]
         self.shield = (
             None

@@ -201,16 +201,28 @@ def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path
             {"max_exponent": 5, "factors": (0.5,)},
             ["hold 32", "paper x0.5"],
         ),
+        (
+            "etsc/ClusterContainmentCentral-v0",
+            {"horizon_s": 20.0},
+            {"factors": (1.0,), "rule_channel_heartbeat": 150, "sampling_period_s": 0.01},
+            ["paper x1, channel heartbeat 150"],
+        ),
+        (
+            "etsc/ClusterContainment-v0",
+            {"horizon_s": 20.0},
+            {"factors": (1.0,), "rule_channel_heartbeat": 150, "sampling_period_s": 0.01},
+            ["paper x1, channel heartbeat 150"],
+        ),
     ],
 )
 def test_a_stand_alone_trigger_takes_the_constant_decisions_actions(
     env_id, env_kwargs, decision_keywords, labels
 ):
     """Where a decision always taken is a stand-alone trigger (the clock, the rule at a
-    scaled threshold), the compiled run of that trigger gives the records of the deployed
-    decision policy (run decision by decision, the episode of the per-instant deployment:
-    tests/test_batch.py): the same transmissions, cost and failure, and the same return up to
-    the order of its sum."""
+    scaled threshold, with a heartbeat per channel), the compiled run of that trigger gives the
+    records of the deployed decision policy (run decision by decision, the episode of the
+    per-instant deployment: tests/test_batch.py): the same transmissions, cost and failure, and
+    the same return up to the order of its sum."""
     decisions = DecisionSet(env_id, **decision_keywords)
     seeds = scenario_set("validation", SET_SIZE).seeds
     setup = episode_setup(env_id, env_kwargs)

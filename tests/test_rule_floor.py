@@ -14,7 +14,7 @@ from agents.decisions import SelfTriggeredWrapper
 from baselines.episodes import run_episode
 from baselines.self_triggered import DecisionSet
 from etsc_envs.triggers import OrbitAttitudeTrigger
-from etsc_envs.triggers.base import floor_seconds, floored_trigger_class
+from etsc_envs.triggers.base import floored_trigger_class, instants_seconds
 from tests.test_decisions import RecordedActions
 
 ORBIT = "etsc/OrbitAttitudeTracking-v0"
@@ -31,7 +31,7 @@ def floored(env: gym.Env, floor: int, **keywords) -> OrbitAttitudeTrigger:
         env.observation_space,
         env.action_space,
         env.unwrapped.observation_names,
-        floor_s=floor_seconds(floor, SAMPLING_PERIOD_S),
+        floor_s=instants_seconds(floor, SAMPLING_PERIOD_S),
         **keywords,
     )
 

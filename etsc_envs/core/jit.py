@@ -83,7 +83,10 @@ def parallel_jit(function: Callable[..., Any]) -> Callable[..., Any]:
 def compiled_function_identity(function: Any) -> tuple[Any, ...]:
     """What a compiled function (or a closure over compiled functions) is, the same in every
     process: module, qualified name, bytecode, the stamp (modification time and size) of its
-    source file, and recursively the identity of every function it closes over."""
+    source file, and recursively the identity of every function it closes over; a value that
+    is not a function (a flag a factory closes over) is its ``repr``."""
+    if not callable(function):
+        return (repr(function),)
     python_function = getattr(function, "py_func", function)
     try:
         source = inspect.getsourcefile(python_function)
@@ -92,10 +95,7 @@ def compiled_function_identity(function: Any) -> tuple[Any, ...]:
     except (OSError, TypeError):
         stamp = None
     cells = tuple(
-        compiled_function_identity(cell.cell_contents)
-        if callable(cell.cell_contents)
-        else repr(cell.cell_contents)
-        for cell in python_function.__closure__ or ()
+        compiled_function_identity(cell.cell_contents) for cell in python_function.__closure__ or ()
     )
     return (
         python_function.__module__,

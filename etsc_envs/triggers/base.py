@@ -246,23 +246,70 @@ def time_since_transmission_indices(
 
 
 @functools.cache
-def floored_rule(rule: Callable[..., None]) -> Callable[..., None]:
-    """The compiled kernel of ``rule`` with a floor: ``rule``'s decisions, except that a channel
-    whose time since transmission (the last ``C`` entries of ``indices``, C the channels) is
-    below the floor (the last entry of ``parameters``, s) holds. ``rule`` reads its own
+def channel_timed_rule(rule: Callable[..., None], heartbeat: bool) -> Callable[..., None]:
+    """The compiled kernel of ``rule`` with a bound B on each channel's time since
+    transmission (the last ``C`` entries of ``indices``, C the channels; B the last entry of
+    ``parameters``, s): with ``heartbeat`` every channel whose time has reached B transmits
+    besides those ``rule`` fires for (a maximum inter-event time); without, a channel whose
+    time is below B holds (a floor, a minimum inter-event time). ``rule`` reads its own
     indices and parameters by position, ahead of those entries."""
 
     @closure_jit
-    def floored(observation, indices, parameters, out):
+    def timed(observation, indices, parameters, out):
         rule(observation, indices, parameters, out)
         n_channels = out.shape[0]
         first_time = indices.shape[0] - n_channels
-        floor_s = parameters[parameters.shape[0] - 1]
+        bound_s = parameters[parameters.shape[0] - 1]
         for channel in range(n_channels):
-            if float(observation[indices[first_time + channel]]) < floor_s:
+            reached = float(observation[indices[first_time + channel]]) >= bound_s
+            if heartbeat and reached:
+                out[channel] = 1
+            elif not heartbeat and not reached:
                 out[channel] = 0
 
-    return floored
+    return timed
+
+
+def _channel_timed_trigger_class(
+    trigger_class: type[RuleTrigger],
+    kernel: Callable[..., None],
+    keyword: str,
+    name: str,
+) -> type[RuleTrigger]:
+    """A :class:`RuleTrigger` class running ``kernel`` (``trigger_class``'s rule with a bound
+    on each channel's time since transmission, in seconds: the keyword ``keyword``), built with
+    ``(observation_space, action_space, observation_names, keyword=..., **keywords)``,
+    ``keywords`` those of ``trigger_class``."""
+
+    class ChannelTimedTrigger(RuleTrigger):
+        rule = staticmethod(kernel)
+
+        def __init__(
+            self,
+            observation_space: gym.Space,
+            action_space: gym.Space,
+            observation_names: tuple[str, ...],
+            **keywords: Any,
+        ) -> None:
+            if keyword not in keywords:
+                raise TypeError(f"{name} needs the keyword {keyword} (s)")
+            seconds = float(keywords.pop(keyword))
+            if not np.isfinite(seconds) or seconds <= 0.0:
+                raise ValueError(f"{keyword} must be a finite number > 0 (s), got {seconds!r}")
+            inner = trigger_class(observation_space, action_space, observation_names, **keywords)
+            times = time_since_transmission_indices(observation_names, inner.n_channels)
+            setattr(self, keyword, seconds)
+            self.inner = inner
+            super().__init__(
+                observation_space,
+                action_space,
+                indices=[*inner.rule_indices, *times],
+                parameters=[*inner.rule_parameters, seconds],
+                keywords={**inner.keywords, keyword: seconds},
+            )
+
+    ChannelTimedTrigger.__name__ = ChannelTimedTrigger.__qualname__ = name
+    return ChannelTimedTrigger
 
 
 @functools.cache
@@ -275,42 +322,38 @@ def floored_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]
     compiled loop compiles each floored rule once. At a reset the time since transmission is
     0, so a floored trigger alone first transmits once the floor has passed; a decision set's
     floored action transmits at its decision instant (:mod:`baselines.self_triggered`)."""
-
-    class FlooredTrigger(RuleTrigger):
-        rule = staticmethod(floored_rule(trigger_class.rule))
-
-        def __init__(
-            self,
-            observation_space: gym.Space,
-            action_space: gym.Space,
-            observation_names: tuple[str, ...],
-            floor_s: float,
-            **keywords: Any,
-        ) -> None:
-            floor_s = float(floor_s)
-            if not np.isfinite(floor_s) or floor_s <= 0.0:
-                raise ValueError(f"floor_s must be a finite number > 0 (s), got {floor_s!r}")
-            inner = trigger_class(observation_space, action_space, observation_names, **keywords)
-            times = time_since_transmission_indices(observation_names, inner.n_channels)
-            self.floor_s = floor_s
-            self.inner = inner
-            super().__init__(
-                observation_space,
-                action_space,
-                indices=[*inner.rule_indices, *times],
-                parameters=[*inner.rule_parameters, floor_s],
-                keywords={**inner.keywords, "floor_s": floor_s},
-            )
-
-    FlooredTrigger.__name__ = FlooredTrigger.__qualname__ = f"Floored{trigger_class.__name__}"
-    return FlooredTrigger
+    return _channel_timed_trigger_class(
+        trigger_class,
+        channel_timed_rule(trigger_class.rule, heartbeat=False),
+        "floor_s",
+        f"Floored{trigger_class.__name__}",
+    )
 
 
-def floor_seconds(floor: int, sampling_period_s: float) -> float:
-    """The ``floor_s`` of a floor of ``floor`` sampling instants: a channel that transmitted at
-    instant k may transmit again from instant k + ``floor`` on (its time since transmission
-    there is ``floor`` periods; half a period below, so float32 observations compare safely)."""
-    return (int(floor) - 0.5) * float(sampling_period_s)
+@functools.cache
+def channel_heartbeat_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
+    """A :class:`RuleTrigger` class whose triggers are those of ``trigger_class`` with a
+    heartbeat per channel: a channel transmits when ``trigger_class``'s rule fires for it or
+    once ``heartbeat_s`` seconds have passed since its own last transmission (a maximum
+    inter-event time per channel; unlike :class:`HeartbeatPolicy`, one channel's heartbeat
+    sends that channel alone, as a follower of paper 001 with a heartbeat of its own would).
+    Built with ``(observation_space, action_space, observation_names, heartbeat_s,
+    **keywords)``; one class per rule, so the compiled loop compiles each once. At a reset the
+    time since transmission is 0, so the heartbeat first beats ``heartbeat_s`` after it."""
+    return _channel_timed_trigger_class(
+        trigger_class,
+        channel_timed_rule(trigger_class.rule, heartbeat=True),
+        "heartbeat_s",
+        f"ChannelHeartbeat{trigger_class.__name__}",
+    )
+
+
+def instants_seconds(instants: int, sampling_period_s: float) -> float:
+    """The time since transmission that marks ``instants`` sampling instants: a channel that
+    transmitted at instant k reaches it at instant k + ``instants`` (its time since
+    transmission there is ``instants`` periods; half a period below, so float32 observations
+    compare safely). A floor or heartbeat of ``instants`` instants is this many seconds."""
+    return (int(instants) - 0.5) * float(sampling_period_s)
 
 
 @jit
@@ -360,7 +403,7 @@ class ClockTrigger(RuleTrigger):
             observation_space,
             action_space,
             indices=times,
-            parameters=[floor_seconds(self.every, period), 0.5 * period],
+            parameters=[instants_seconds(self.every, period), 0.5 * period],
             keywords={"every": self.every, "sampling_period_s": period},
         )
 
