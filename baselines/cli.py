@@ -206,12 +206,11 @@ def _policy_for(
         channel_heartbeat = arguments.pop("channel_heartbeat", None)
         trigger_class = triggers[env_id]
         if channel_heartbeat is not None:
-            if not isinstance(channel_heartbeat, int) or isinstance(channel_heartbeat, bool):
-                channel_heartbeat = 0
-            if channel_heartbeat < 1:
+            whole = isinstance(channel_heartbeat, int) and not isinstance(channel_heartbeat, bool)
+            if not whole or channel_heartbeat < 1:
                 raise ValueError(
                     f"--policy-arg channel_heartbeat must be an integer >= 1 (sampling "
-                    f"instants), got {policy_args['channel_heartbeat']!r}"
+                    f"instants), got {channel_heartbeat!r}"
                 )
             trigger_class = channel_heartbeat_trigger_class(trigger_class)
             arguments["heartbeat_s"] = instants_seconds(channel_heartbeat, loop().sampling_period_s)

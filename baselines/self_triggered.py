@@ -177,9 +177,11 @@ class DecisionSet:
         for heartbeat in given_heartbeats:
             if heartbeat is None and isinstance(self.rule_channel_heartbeat, tuple):
                 continue
-            if not isinstance(heartbeat, int) or isinstance(heartbeat, bool):
-                heartbeat = -1
-            if not 1 <= heartbeat <= 2**20:
+            if (
+                isinstance(heartbeat, bool)
+                or not isinstance(heartbeat, int)
+                or not 1 <= heartbeat <= 2**20
+            ):
                 raise ValueError(
                     f"rule_channel_heartbeat must be an integer in 1..{2**20}, a list of them "
                     f"or None (one per factor) or None, got {self.rule_channel_heartbeat!r}"
@@ -345,10 +347,8 @@ def scaled_rule_trigger(
     trigger_class = RULE_FAMILIES[rule][0][env_id]
     keywords = scaled_thresholds(env_id, factor, rule)
     if floor_s is not None:
-        trigger_class, keywords = (
-            floored_trigger_class(trigger_class),
-            {**keywords, "floor_s": floor_s},
-        )
+        trigger_class = floored_trigger_class(trigger_class)
+        keywords = {**keywords, "floor_s": floor_s}
     if heartbeat_s is not None:
         trigger_class = channel_heartbeat_trigger_class(trigger_class)
         keywords = {**keywords, "heartbeat_s": heartbeat_s}
