@@ -17,7 +17,12 @@ from baselines.self_triggered import decision_set_path, load_self_triggered
 from etsc_envs.core.compiled_loop import always_accepts
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
-from etsc_envs.triggers import RULE_FAMILIES, AlwaysPolicy, PeriodicPolicy
+from etsc_envs.triggers import (
+    RULE_FAMILIES,
+    AlwaysPolicy,
+    PeriodicPolicy,
+    SwitchedPeriodicPolicy,
+)
 from etsc_envs.triggers.base import (
     ClockTrigger,
     HeartbeatPolicy,
@@ -177,15 +182,25 @@ def _policy_for(
     decisions as a rule that the compiled loop runs (:mod:`baselines.batch`) — where the
     receiver takes every transmission; where it may refuse one (paper 003's burst in
     progress), the time since transmission no longer counts the clock's instants, and
-    ``periodic`` is the counter-based :class:`PeriodicPolicy`."""
+    ``periodic`` is the counter-based :class:`PeriodicPolicy`. ``periodic`` with
+    ``then_every`` and ``switch_after`` is :class:`SwitchedPeriodicPolicy` (every ``every``
+    instants before instant ``switch_after``, every ``then_every`` after it)."""
     if spec == "always":
         return AlwaysPolicy(observation_space, action_space, **policy_args)
     if spec == "periodic":
-        if set(policy_args) - {"every"}:
+        switch = {"then_every", "switch_after"}
+        if set(policy_args) - {"every"} - switch:
             raise ValueError(
-                f"--policy-arg: periodic takes every=K (sampling instants) only, got "
-                f"{sorted(policy_args)}"
+                f"--policy-arg: periodic takes every=K, and then_every=K2 with "
+                f"switch_after=N (sampling instants), got {sorted(policy_args)}"
             )
+        if switch & set(policy_args):
+            if not switch <= set(policy_args) or "every" not in policy_args:
+                raise ValueError(
+                    f"--policy-arg: a switched periodic policy takes every, then_every and "
+                    f"switch_after together, got {sorted(policy_args)}"
+                )
+            return SwitchedPeriodicPolicy(observation_space, action_space, **policy_args)
         environment = loop()
         if environment.kernels.accepts is not always_accepts:
             return PeriodicPolicy(observation_space, action_space, **policy_args)

@@ -8,7 +8,8 @@ POLICY is ``paper`` (the paper's triggering rule; ``--policy-arg heartbeat=H`` p
 heartbeat, a transmission on every channel once H instants passed without one), ``error_time``
 (paper 004's error-time rule, ``--policy-arg area=A`` in m·s,
 :data:`etsc_envs.triggers.ERROR_TIME_TRIGGERS`; ``heartbeat=H`` pairs it too), ``periodic``
-(``--policy-arg every=K``), ``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3
+(``--policy-arg every=K``; with ``then_every=K2`` and ``switch_after=N`` the period becomes
+K2 at instant N), ``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3
 model). ``--scenarios`` runs a fixed scenario set of the test protocol (docs/protocol.md);
 ``--episodes/--seed`` run ad-hoc draws instead. The JSON holds every episode's record, the
 means, and the aggregates with 95 % intervals (mean, median, IQM of mean_cost, transmissions

@@ -6,7 +6,10 @@ Checked properties:
   action space, a batch ``(n, obs_dim)`` gives ``(n,)`` actions; the paper's trigger transmits
   exactly when the eq. (27) statistic exceeds Ψ;
 * ``PeriodicPolicy(every=K)`` transmits at steps 0, K, 2K, ... of an episode, restarts its
-  counter on ``episode_start`` and rejects non-positive periods;
+  counter on ``episode_start`` and rejects non-positive periods; ``SwitchedPeriodicPolicy``
+  keeps period K before instant N and K2 after it (counted from the last transmission), is
+  the plain clock when N = 0 or beyond the episode, restarts at an episode's start, and runs
+  from the command line;
 * ``evaluate`` returns the design page's JSON (``env``, ``policy``, ``episodes`` records with the
   required keys, ``mean``), whose ``return`` is the sum of the episode's rewards; the command
   line writes parseable JSON to stdout and turns bad input into argparse errors (exit code 2);
@@ -33,7 +36,13 @@ from baselines.episodes import run_episode, to_jsonable
 from baselines.evaluate import evaluate
 from baselines.policies import infer_sb3_algorithm, load_sb3
 from baselines.reproductions.report import Scenario, claim, metric_row, render, stages
-from etsc_envs.triggers import PAPER_TRIGGERS, AlwaysPolicy, AttitudeTrackingTrigger, PeriodicPolicy
+from etsc_envs.triggers import (
+    PAPER_TRIGGERS,
+    AlwaysPolicy,
+    AttitudeTrackingTrigger,
+    PeriodicPolicy,
+    SwitchedPeriodicPolicy,
+)
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 RECORD_KEYS = {
@@ -179,6 +188,74 @@ def test_periodic_rejects_bad_period(env, every):
         make_trigger("periodic", env, every=every)
 
 
+def switched_clock(env: gym.Env, **kwargs) -> SwitchedPeriodicPolicy:
+    """A :class:`SwitchedPeriodicPolicy` for ``env``."""
+    return SwitchedPeriodicPolicy(env.observation_space, env.action_space, **kwargs)
+
+
+def decisions_of(policy, obs: np.ndarray, steps: int) -> list[int]:
+    """``policy``'s decisions over ``steps`` instants of one episode (a fixed observation: the
+    clocks do not read it)."""
+    state, decisions = None, []
+    for step in range(steps):
+        start = np.array([step == 0])
+        action, state = policy.predict(obs, state=state, episode_start=start)
+        decisions.append(int(action))
+    return decisions
+
+
+def test_switched_clock_changes_its_period_at_switch_after(env):
+    obs, _ = env.reset(seed=0)
+    decisions = decisions_of(switched_clock(env, every=3, then_every=2, switch_after=7), obs, 13)
+    # every 3 before instant 7 (0, 3, 6), then 2 instants after the last transmission (8, 10, 12)
+    assert [step for step, sent in enumerate(decisions) if sent] == [0, 3, 6, 8, 10, 12]
+    early = decisions_of(switched_clock(env, every=4, then_every=2, switch_after=100), obs, 40)
+    late = decisions_of(switched_clock(env, every=4, then_every=3, switch_after=0), obs, 40)
+    assert early == decisions_of(make_trigger("periodic", env, every=4), obs, 40)
+    assert late == decisions_of(make_trigger("periodic", env, every=3), obs, 40)
+
+
+def test_switched_clock_counts_in_an_episode_and_restarts(env):
+    policy = switched_clock(env, every=10, then_every=5, switch_after=50)
+    for seed in (0, 1):  # the second episode restarts both counters
+        record, trace = run_episode(env, policy, seed=seed)
+        assert record["transmissions"] == 5 + 10
+        expected = np.concatenate([np.arange(0, 50, 10), np.arange(50, 100, 5)]) * 0.001
+        assert_allclose(trace.transmission_times_s, expected, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"every": 0, "then_every": 2, "switch_after": 5}, "every"),
+        ({"every": 2, "then_every": 1.5, "switch_after": 5}, "then_every"),
+        ({"every": 2, "then_every": 2, "switch_after": -1}, "switch_after"),
+        ({"every": True, "then_every": 2, "switch_after": 5}, "every"),
+    ],
+)
+def test_switched_clock_rejects_bad_input(env, kwargs, name):
+    with pytest.raises(ValueError, match=f"^{name} must be an integer"):
+        switched_clock(env, **kwargs)
+
+
+def test_evaluate_command_runs_a_switched_clock(capsys):
+    result = evaluate_cli(
+        capsys,
+        ENV_ID,
+        "--policy",
+        "periodic",
+        "--policy-arg",
+        "every=10",
+        "--policy-arg",
+        "then_every=2",
+        "--policy-arg",
+        "switch_after=20",
+        "--env-arg",
+        "horizon_s=0.05",
+    )
+    assert result["episodes"][0]["transmissions"] == 2 + 15
+
+
 # --------------------------------------------------------------------------- evaluate
 def test_evaluate_returns_the_design_page_json():
     result = evaluate(ENV_ID, "paper", env_args={"horizon_s": 0.2}, episodes=2, seed=5)
@@ -237,6 +314,8 @@ SHORT = ["--env-arg", "horizon_s=0.01"]
         (["--policy", "always", "--env-arg", "horizon_s"], "key=value"),
         (["--policy", "always", "--env-arg", "horizon=1"], "unknown argument"),
         (["--policy", "periodic", "--policy-arg", "every=0", *SHORT], "every"),
+        (["--policy", "periodic", "--policy-arg", "then_every=2", *SHORT], "together"),
+        (["--policy", "periodic", "--policy-arg", "phase=2", *SHORT], "then_every=K2"),
     ],
 )
 def test_evaluate_command_reports_bad_input(capsys, argv, message):

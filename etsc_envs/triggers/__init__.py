@@ -1,6 +1,7 @@
 """Reference trigger policies: the papers' own triggering rules (one module per problem, looked
 up by environment id in :data:`PAPER_TRIGGERS`), the time-triggered references
-:class:`AlwaysPolicy` and :class:`PeriodicPolicy` (compiled: :class:`ClockTrigger`), and other
+:class:`AlwaysPolicy` and :class:`PeriodicPolicy` (compiled: :class:`ClockTrigger`; a clock
+that changes its period once: :class:`SwitchedPeriodicPolicy`), and other
 event rules on the same signals (:data:`ERROR_TIME_TRIGGERS`); :data:`RULE_FAMILIES` names
 each family of rules.
 
@@ -22,7 +23,13 @@ from collections.abc import Callable
 
 from etsc_envs.triggers.asteroid import PAPER_ALPHA, AsteroidOrbitKeepingTrigger, AsteroidShield
 from etsc_envs.triggers.attitude_tracking import PAPER_PSI, AttitudeTrackingTrigger
-from etsc_envs.triggers.base import AlwaysPolicy, ClockTrigger, PeriodicPolicy, TriggerPolicy
+from etsc_envs.triggers.base import (
+    AlwaysPolicy,
+    ClockTrigger,
+    PeriodicPolicy,
+    SwitchedPeriodicPolicy,
+    TriggerPolicy,
+)
 from etsc_envs.triggers.cluster import PAPER_C, ClusterContainmentTrigger
 from etsc_envs.triggers.inner_formation import (
     InnerFormationErrorTimeTrigger,
@@ -111,5 +118,6 @@ __all__ = [
     "InnerFormationTrigger",
     "OrbitAttitudeTrigger",
     "PeriodicPolicy",
+    "SwitchedPeriodicPolicy",
     "TriggerPolicy",
 ]

@@ -152,6 +152,14 @@ class AlwaysPolicy(TriggerPolicy):
         return np.ones(shape, dtype=bool), state
 
 
+def _instants(name: str, value: Any, least: int) -> int:
+    """``value`` as a whole number of sampling instants ``>= least``, or ``ValueError`` naming
+    ``name``."""
+    if isinstance(value, bool) or int(value) != value or value < least:
+        raise ValueError(f"{name} must be an integer >= {least} (sampling instants), got {value!r}")
+    return int(value)
+
+
 class PeriodicPolicy(TriggerPolicy):
     """Transmit every ``every`` sampling instants, starting with the first (time-triggered).
 
@@ -161,9 +169,7 @@ class PeriodicPolicy(TriggerPolicy):
 
     def __init__(self, observation_space: gym.Space, action_space: gym.Space, every: int = 1):
         super().__init__(observation_space, action_space)
-        if int(every) != every or every < 1:
-            raise ValueError(f"every must be an integer >= 1 (sampling instants), got {every!r}")
-        self.every = int(every)
+        self.every = _instants("every", every, 1)
 
     def reset_state(self, state: Any, episode_start: np.ndarray, batch: int) -> Any:
         counters = np.zeros(batch, dtype=np.int64) if state is None else np.array(state)
@@ -176,6 +182,50 @@ class PeriodicPolicy(TriggerPolicy):
         if self.n_bits is not None:
             decision = np.repeat(decision[:, None], self.n_bits, axis=1)
         return decision, counters + 1
+
+
+class SwitchedPeriodicPolicy(TriggerPolicy):
+    """A clock that changes its period once: transmit at the first instant, then whenever
+    ``every`` instants have passed since the last transmission before instant ``switch_after``
+    and ``then_every`` instants from it on (a time-switched clock, for asking whether a
+    clock's transmissions are better spent early or late in an episode).
+
+    The recurrent ``state`` holds, per row, the instants since the episode began and since the
+    last transmission; pass ``episode_start`` (or ``state=None`` at a reset) to restart them.
+    With ``switch_after = 0`` it is :class:`PeriodicPolicy` at ``then_every``.
+    """
+
+    def __init__(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        every: int,
+        then_every: int,
+        switch_after: int,
+    ) -> None:
+        super().__init__(observation_space, action_space)
+        self.every = _instants("every", every, 1)
+        self.then_every = _instants("then_every", then_every, 1)
+        self.switch_after = _instants("switch_after", switch_after, 0)
+
+    def reset_state(self, state: Any, episode_start: np.ndarray, batch: int) -> Any:
+        if state is None:
+            return None
+        elapsed, silent = (np.array(part) for part in state)
+        elapsed[episode_start] = 0
+        silent[episode_start] = 0
+        return elapsed, silent
+
+    def transmit(self, obs: np.ndarray, state: Any) -> tuple[np.ndarray, Any]:
+        if state is None:
+            state = (np.zeros(len(obs), dtype=np.int64), np.zeros(len(obs), dtype=np.int64))
+        elapsed, silent = (np.asarray(part) for part in state)
+        period = np.where(elapsed < self.switch_after, self.every, self.then_every)
+        decision = (elapsed == 0) | (silent >= period)
+        silent = np.where(decision, 1, silent + 1)
+        if self.n_bits is not None:
+            decision = np.repeat(decision[:, None], self.n_bits, axis=1)
+        return decision, (elapsed + 1, silent)
 
 
 class HeartbeatPolicy(TriggerPolicy):
@@ -193,12 +243,8 @@ class HeartbeatPolicy(TriggerPolicy):
 
     def __init__(self, trigger: TriggerPolicy, heartbeat: int) -> None:
         super().__init__(trigger.observation_space, trigger.action_space)
-        if isinstance(heartbeat, bool) or int(heartbeat) != heartbeat or heartbeat < 1:
-            raise ValueError(
-                f"heartbeat must be an integer >= 1 (sampling instants), got {heartbeat!r}"
-            )
         self.trigger = trigger
-        self.heartbeat = int(heartbeat)
+        self.heartbeat = _instants("heartbeat", heartbeat, 1)
 
     def reset_state(self, state: Any, episode_start: np.ndarray, batch: int) -> Any:
         if state is None:
