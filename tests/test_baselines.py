@@ -239,20 +239,10 @@ def test_switched_clock_rejects_bad_input(env, kwargs, name):
 
 
 def test_evaluate_command_runs_a_switched_clock(capsys):
-    result = evaluate_cli(
-        capsys,
-        ENV_ID,
-        "--policy",
-        "periodic",
-        "--policy-arg",
-        "every=10",
-        "--policy-arg",
-        "then_every=2",
-        "--policy-arg",
-        "switch_after=20",
-        "--env-arg",
-        "horizon_s=0.05",
-    )
+    arguments = ["every=10", "then_every=2", "switch_after=20"]
+    policy = [word for argument in arguments for word in ("--policy-arg", argument)]
+    short = ["--env-arg", "horizon_s=0.05"]
+    result = evaluate_cli(capsys, ENV_ID, "--policy", "periodic", *policy, *short)
     assert result["episodes"][0]["transmissions"] == 2 + 15
 
 
