@@ -17,6 +17,7 @@ from baselines.self_triggered import decision_set_path, load_self_triggered
 from etsc_envs.core.compiled_loop import always_accepts
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.validation import require_int_at_least
 from etsc_envs.triggers import (
     RULE_FAMILIES,
     AlwaysPolicy,
@@ -221,12 +222,9 @@ def _policy_for(
         channel_heartbeat = arguments.pop("channel_heartbeat", None)
         trigger_class = triggers[env_id]
         if channel_heartbeat is not None:
-            whole = isinstance(channel_heartbeat, int) and not isinstance(channel_heartbeat, bool)
-            if not whole or channel_heartbeat < 1:
-                raise ValueError(
-                    f"--policy-arg channel_heartbeat must be an integer >= 1 (sampling "
-                    f"instants), got {channel_heartbeat!r}"
-                )
+            channel_heartbeat = require_int_at_least(
+                "--policy-arg channel_heartbeat", channel_heartbeat, 1
+            )
             trigger_class = channel_heartbeat_trigger_class(trigger_class)
             arguments["heartbeat_s"] = instants_seconds(channel_heartbeat, loop().sampling_period_s)
         trigger = trigger_class(observation_space, action_space, names, **arguments)

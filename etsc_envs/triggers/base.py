@@ -435,14 +435,12 @@ class ClockTrigger(RuleTrigger):
         every: int = 1,
         sampling_period_s: float = 1.0,
     ) -> None:
-        if isinstance(every, bool) or int(every) != every or every < 1:
-            raise ValueError(f"every must be an integer >= 1 (sampling instants), got {every!r}")
+        self.every = _instants("every", every, 1)
         period = float(sampling_period_s)
         if not np.isfinite(period) or period <= 0.0:
             raise ValueError(
                 f"sampling_period_s must be a finite number > 0 (s), got {sampling_period_s!r}"
             )
-        self.every = int(every)
         channels = 1 if transmit_bits(action_space) is None else transmit_bits(action_space)
         times = time_since_transmission_indices(observation_names, channels)
         super().__init__(
