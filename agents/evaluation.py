@@ -17,10 +17,11 @@ import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
+from agents.model_files import write_model
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
-from baselines.policies import NormalizedModel, normalization_path
+from baselines.policies import NormalizedModel
 from baselines.self_triggered import DecisionSet, IntervalSchedule, SelfTriggeredPolicy
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.protocol import scenario_set
@@ -172,19 +173,8 @@ class PaperComparisonCallback(BaseCallback):
         return run_batch(self.env_id, policy, self.scenarios.seeds, self.env_kwargs)
 
     def _save_best(self) -> None:
-        """The current model (and statistics) as the best so far, each file replaced whole."""
-        path = self.best_model_path
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if self.decisions is not None:
-            self.decisions.save(path)
-        temporary = path.with_name(f".{path.stem}.partial.zip")
-        self.model.save(temporary)
-        temporary.replace(path)
-        normalization = self.model.get_vec_normalize_env()
-        if normalization is not None:
-            partial_statistics = normalization_path(temporary)
-            normalization.save(partial_statistics)
-            partial_statistics.replace(normalization_path(path))
+        """The current model (with statistics and decision set) as the best so far."""
+        write_model(self.model, self.best_model_path, self.decisions)
 
     def _current_policy(self) -> Any:
         """The model, reading observations through a frozen copy of the training statistics

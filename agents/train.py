@@ -30,7 +30,6 @@ import argparse
 import dataclasses
 import functools
 import importlib.util
-import io
 import json
 import pickle
 import sys
@@ -67,10 +66,11 @@ from agents.elapsed_discount import (
 )
 from agents.evaluation import PaperComparisonCallback
 from agents.imitation import imitate_decision, imitate_paper_trigger
+from agents.model_files import write_model
 from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
 from baselines.policies import ENV_ID_ATTRIBUTE, normalization_path
 from baselines.self_triggered import DecisionSet
-from etsc_envs.core.files import atomic_write_bytes, atomic_write_text
+from etsc_envs.core.files import atomic_write_text
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
@@ -218,7 +218,7 @@ def _train(
             if hasattr(bar, "pbar"):
                 bar.pbar.close()
     wall_time_s = time.perf_counter() - start
-    save_model(model, out_dir / MODEL_FILE, decisions)
+    write_model(model, out_dir / MODEL_FILE, decisions)
     env.close()
     _write_config(written, out_dir / CONFIG_FILE)
     summary = _summary(config, model, metrics_callback, wall_time_s)
@@ -328,24 +328,10 @@ def decision_set(config: TrainConfig, env: VecEnv) -> DecisionSet | None:
     return None if config.decisions is None else env.get_attr("decisions", [0])[0]
 
 
-def save_model(model: BaseAlgorithm, path: Path, decisions: DecisionSet | None = None) -> None:
-    """Save ``model`` at ``path`` and its normalisation statistics and decision set beside it
-    (if any), each through a temporary file and a rename, the model last: a model file on disk
-    always has its statistics and decision set."""
-    if decisions is not None:
-        decisions.save(path)
-    normalization = model.get_vec_normalize_env()
-    if normalization is not None:
-        atomic_write_bytes(normalization_path(path), pickle.dumps(normalization))
-    buffer = io.BytesIO()
-    model.save(buffer)
-    atomic_write_bytes(path, buffer.getvalue())
-
-
 class AtomicCheckpointCallback(CheckpointCallback):
     """SB3's checkpoints (``model_<N>_steps.zip`` with ``model_vecnormalize_<N>_steps.pkl``
     and, for self-triggered decisions, ``model_<N>_steps_decisions.json``), written through
-    temporary files, the model last (:func:`save_model`)."""
+    temporary files, the model last (:func:`~agents.model_files.write_model`)."""
 
     def __init__(self, *args: Any, decisions: DecisionSet | None = None, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -353,17 +339,12 @@ class AtomicCheckpointCallback(CheckpointCallback):
 
     def _on_step(self) -> bool:
         if self.n_calls % self.save_freq == 0:
-            if self.decisions is not None:
-                self.decisions.save(self._checkpoint_path(extension="zip"))
-            statistics = self.model.get_vec_normalize_env() if self.save_vecnormalize else None
-            if statistics is not None:
-                atomic_write_bytes(
-                    self._checkpoint_path("vecnormalize_", extension="pkl"),
-                    pickle.dumps(statistics),
-                )
-            buffer = io.BytesIO()
-            self.model.save(buffer)
-            atomic_write_bytes(self._checkpoint_path(extension="zip"), buffer.getvalue())
+            write_model(
+                self.model,
+                Path(self._checkpoint_path(extension="zip")),
+                self.decisions,
+                statistics_path=Path(self._checkpoint_path("vecnormalize_", extension="pkl")),
+            )
         return True
 
 

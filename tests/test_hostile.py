@@ -589,3 +589,60 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
     kept = [entry for entry in before if entry["timesteps"] <= newest]
     assert after[: len(kept)] == kept
     assert [entry["timesteps"] for entry in after] == list(range(64, newest + 129, 64))
+
+
+@pytest.fixture
+def python_sigint_handler():
+    """Python's own SIGINT handler for the test (a test run started in the background
+    ignores SIGINT)."""
+    import signal
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_sigint_inside_interrupts_deferred_arrives_when_the_block_ends(python_sigint_handler):
+    import signal
+
+    from etsc_envs.core.files import interrupts_deferred
+
+    finished = False
+    with pytest.raises(KeyboardInterrupt), interrupts_deferred():
+        signal.raise_signal(signal.SIGINT)
+        finished = True
+    assert finished
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    with interrupts_deferred():  # no signal, nothing raised
+        pass
+
+
+def test_a_model_interrupted_while_being_written_is_written_whole(
+    tmp_path: Path, python_sigint_handler
+):
+    """SIGINT in the middle of writing a model (where PyTorch's zip writer would turn it into
+    a ``RuntimeError``) waits until the model and its statistics are on disk."""
+    import signal
+
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    from agents.model_files import write_model
+    from baselines.policies import normalization_path
+
+    env = VecNormalize(DummyVecEnv([lambda: gym.make(GYM_IDS[0], **SHORT[GYM_IDS[0]])]))
+    model = PPO("MlpPolicy", env, n_steps=64, batch_size=64, device="cpu")
+    save = model.save
+
+    def interrupted_save(*args, **kwargs):
+        signal.raise_signal(signal.SIGINT)
+        save(*args, **kwargs)
+
+    model.save = interrupted_save
+    path = tmp_path / "model.zip"
+    with pytest.raises(KeyboardInterrupt):
+        write_model(model, path)
+    assert normalization_path(path).is_file()
+    restored = PPO.load(path, device="cpu")
+    for name, tensor in model.policy.state_dict().items():
+        assert np.array_equal(restored.policy.state_dict()[name].numpy(), tensor.numpy())

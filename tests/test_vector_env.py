@@ -161,6 +161,16 @@ def test_bad_vector_arguments_name_the_argument(kwargs, message):
         AttitudeTrackingVectorEnv(**kwargs)
 
 
+def test_a_vector_env_refused_by_its_constructor_closes_quietly():
+    """``__del__`` closes the half-made object a refused constructor leaves: no thread pool
+    or sub-environment exists yet, and closing must not raise."""
+    from etsc_envs.attitude_tracking.env import AttitudeTrackingVectorEnv
+
+    half_made = AttitudeTrackingVectorEnv.__new__(AttitudeTrackingVectorEnv)
+    half_made.close()
+    assert half_made.closed
+
+
 @pytest.mark.parametrize("actions", [np.array([0, 2]), np.array([1, 0, 1]), np.ones((2, 2))])
 def test_bad_actions_name_the_allowed_shape_and_values(actions):
     vector = make_native("etsc/AttitudeTracking-v0", 2)

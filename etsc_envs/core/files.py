@@ -4,15 +4,20 @@ Every tool of the suite that writes results (JSON, plots, models, summaries) che
 destination before the work starts (:func:`require_writable_file`) and writes through a
 temporary file in the same folder followed by an atomic rename (:func:`atomic_write_text`,
 :func:`atomic_write_bytes`), so an interrupted or failed run never leaves a partly written
-file where a finished one is expected.
+file where a finished one is expected. A write that goes through a library which turns an
+interrupt into an error of its own (PyTorch's zip writer does) runs inside
+:func:`interrupts_deferred`, so Ctrl-C still ends the run as an interrupt, just after the file.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import tempfile
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -97,3 +102,21 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
 def atomic_write_text(path: str | Path, text: str) -> Path:
     """Write ``text`` (UTF-8) to ``path`` through a temporary file and a rename."""
     return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+@contextmanager
+def interrupts_deferred() -> Iterator[None]:
+    """Hold SIGINT until the block ends, then deliver it to the handler that was in place
+    (``KeyboardInterrupt`` under Python's default). Outside the main thread, where Python
+    cannot install signal handlers, the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if received:
+        signal.raise_signal(signal.SIGINT)

@@ -308,9 +308,12 @@ class EventTriggeredVectorEnv(VectorEnv):
         return tuple(env.render() for env in self.envs)
 
     def close_extras(self, **kwargs: Any) -> None:
-        if self._pool is not None:
-            self._pool.shutdown()
-        for env in self.envs:
+        """Stop the stepping threads and close the sub-environments (neither exists yet when
+        the constructor refused its arguments and ``__del__`` closes the half-made object)."""
+        pool = getattr(self, "_pool", None)
+        if pool is not None:
+            pool.shutdown()
+        for env in getattr(self, "envs", ()):
             env.close()
 
     # ----------------------------------------------------------------- internals
