@@ -34,6 +34,7 @@ import json
 import pickle
 import sys
 import time
+import warnings
 import zipfile
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -197,7 +198,7 @@ def _train(
     metrics_callback = EpisodeMetricsCallback()
     start = time.perf_counter()
     periodic = _periodic_callbacks(config, out_dir, env.num_envs, checkpoint, decisions)
-    progress = [ProgressBarCallback()] if _progress_bar_available() else []
+    progress = [TrainingProgressBar()] if _progress_bar_available() else []
     remaining = max(config.total_timesteps - model.num_timesteps, 0)
     steps = whole_rollout_steps(remaining, model)
     if steps != remaining:
@@ -346,6 +347,19 @@ class AtomicCheckpointCallback(CheckpointCallback):
                 statistics_path=Path(self._checkpoint_path("vecnormalize_", extension="pkl")),
             )
         return True
+
+
+class TrainingProgressBar(ProgressBarCallback):
+    """SB3's progress bar without the ``TqdmExperimentalWarning`` ("rich is experimental")
+    that tqdm raises each time the bar opens: a warning on every training run that says
+    nothing about the run."""
+
+    def _on_training_start(self) -> None:
+        from tqdm import TqdmExperimentalWarning
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TqdmExperimentalWarning)
+            super()._on_training_start()
 
 
 def whole_rollout_steps(timesteps: int, model: BaseAlgorithm) -> int:

@@ -22,6 +22,7 @@ Every bootstrap uses :data:`BOOTSTRAP_RESAMPLES` resamples from a generator seed
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -174,14 +175,18 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
         raise ValueError("no scenario has a ratio: the reference is 0 wherever a run is not")
     kept_a, kept_b = a[:, ~worse], b[:, ~worse]
     ratios = np.where(kept_b == 0.0, 1.0, kept_a / np.where(kept_b == 0.0, 1.0, kept_b))
-    point, interval = rly.get_interval_estimates(
-        {"ratio": ratios},
-        lambda scores: np.array([metrics.aggregate_iqm(scores)]),
-        task_bootstrap=True,
-        reps=BOOTSTRAP_RESAMPLES,
-        confidence_interval_size=CONFIDENCE,
-        random_state=np.random.RandomState(BOOTSTRAP_SEED),
-    )
+    with warnings.catch_warnings():
+        # rliable seeds arch's bootstrap through random_state, which arch 7 deprecates (and
+        # rliable keeps arch below 8, where it is gone): the seed still takes effect.
+        warnings.filterwarnings("ignore", "random_state is deprecated", FutureWarning)
+        point, interval = rly.get_interval_estimates(
+            {"ratio": ratios},
+            lambda scores: np.array([metrics.aggregate_iqm(scores)]),
+            task_bootstrap=True,
+            reps=BOOTSTRAP_RESAMPLES,
+            confidence_interval_size=CONFIDENCE,
+            random_state=np.random.RandomState(BOOTSTRAP_SEED),
+        )
     per_run = [float(value) for value in iqm(ratios, axis=1)]
     return {
         "runs": int(a.shape[0]),

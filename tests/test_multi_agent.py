@@ -121,6 +121,8 @@ class Integrators(EventTriggeredEnv):
         return True
 
 
+# the API test resets with options={"options": 1} on purpose; the env says it ignores the key
+@pytest.mark.filterwarnings("ignore:options. unknown key")
 def test_passes_the_pettingzoo_parallel_api_test():
     parallel_api_test(EventTriggeredParallelEnv(Integrators()), num_cycles=50)
 

@@ -89,6 +89,17 @@ def test_train_writes_a_loadable_model(tmp_path: Path) -> None:
     assert env.action_space.contains(int(action))
 
 
+def test_training_raises_no_warning_of_its_own(tmp_path: Path) -> None:
+    """A plain run warns of nothing (tqdm's "rich is experimental" included)."""
+    import warnings
+
+    config_path = write_config(tiny_config(tmp_path / "run"), tmp_path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main(["--config", str(config_path)]) == 0
+    assert [str(warning.message) for warning in caught] == []
+
+
 def test_a_budget_of_part_of_a_rollout_says_it_rounds_up(tmp_path: Path, capsys) -> None:
     config = tiny_config(tmp_path / "run")
     config["hyperparameters"].update(n_steps=64, batch_size=64)
