@@ -17,6 +17,14 @@ ROOT = Path(__file__).parents[1]
 MODELS = sorted((ROOT / "models").glob("*-v0_*.zip"))
 """``models/<id>_<method>.zip``: per-instant PPO (``_ppo``) and self-triggered decisions."""
 RESULTS = ROOT / "docs" / "results"
+CROSS_MACHINE_SPREAD = {"etsc/OrbitAttitudeTracking-v0": 5e-3}
+"""Relative spread of a recorded paper-scenario row between machines, by id: 000's closed loop
+is chaotic at the level of its steady chattering, and rounding that differs between processors
+and library versions moves its 300-s episode by 0.03-0.2 % (``docs/results.md``, "Paper 000:
+eq. (21) gating a clock"); the per-instant PPO row, 300 000 decisions on those states, moved by
+0.21 % in cost and 0.04 % in transmissions between the machine that recorded it and this
+project's 2-core machine (deterministic on each). Every other id's rows are reproduced to the
+last digit."""
 
 
 def env_id_of(model: Path) -> str:
@@ -50,5 +58,6 @@ def test_evaluate_reproduces_the_learned_row_of_the_results(model: Path) -> None
     recorded = json.loads((RESULTS / model.stem / "results.json").read_text(encoding="utf-8"))
     row = recorded["sets"]["paper"]["models"][0]["learned"]["mean"]
     result = evaluate(env_id, f"sb3:{model}", env_args=recorded["env_args"], scenarios="paper")
-    assert result["mean"]["transmissions"] == row["transmissions"]
-    assert result["mean"]["mean_cost"] == pytest.approx(row["mean_cost"], rel=1e-9)
+    spread = CROSS_MACHINE_SPREAD.get(env_id, 0.0)
+    assert result["mean"]["transmissions"] == pytest.approx(row["transmissions"], rel=spread)
+    assert result["mean"]["mean_cost"] == pytest.approx(row["mean_cost"], rel=max(spread, 1e-9))
