@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import itertools
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -14,16 +15,60 @@ from tqdm import tqdm
 import etsc_envs  # noqa: F401  (registers the environment ids)
 
 
+def window_edges(edges_s: Sequence[float]) -> tuple[float, ...]:
+    """``edges_s`` checked as the edges of time windows: at least two finite numbers >= 0 (s),
+    strictly increasing (``ValueError`` naming ``windows_s`` otherwise)."""
+    try:
+        edges = tuple(float(edge) for edge in edges_s)
+    except (TypeError, ValueError):
+        raise ValueError(f"windows_s must be a list of numbers (s), got {edges_s!r}") from None
+    if (
+        len(edges) < 2
+        or not all(np.isfinite(edge) and edge >= 0.0 for edge in edges)
+        or any(later <= earlier for earlier, later in itertools.pairwise(edges))
+    ):
+        raise ValueError(
+            "windows_s must be at least two finite times >= 0 (s), strictly increasing, "
+            f"got {list(edges_s)!r}"
+        )
+    return edges
+
+
 @dataclass
 class EpisodeTrace:
-    """Signals of one episode for plots: per-step time and cost, transmission instants, and
-    states sampled by the environment's ``state_dict``."""
+    """Signals of one episode for plots: per-step time, cost and channels sent, transmission
+    instants, and states sampled by the environment's ``state_dict``."""
 
     time_s: list[float] = field(default_factory=list)
     cost: list[float] = field(default_factory=list)
+    sent: list[int] = field(default_factory=list)
     transmission_times_s: list[float] = field(default_factory=list)
     transmission_actions: list[np.ndarray] = field(default_factory=list)
     samples: list[dict[str, np.ndarray]] = field(default_factory=list)
+
+    def window_totals(self, edges_s: Sequence[float]) -> list[dict[str, float]]:
+        """The episode split by time: for each window ``[a, b)`` of consecutive ``edges_s``,
+        the summed per-step cost (``info["cost"]``, summed over agents for a PettingZoo id) and
+        the channels sent (``info["transmitted"]``) of the steps that start in it (a step runs
+        from the previous step's ``time_s``, the first from 0). Windows that cover the episode
+        add up to its ``mean_cost`` × ``steps`` and its ``transmissions``."""
+        edges = window_edges(edges_s)
+        ends = np.asarray(self.time_s, dtype=float)
+        starts = np.concatenate([[0.0], ends[:-1]])
+        cost = np.asarray(self.cost, dtype=float)
+        sent = np.asarray(self.sent, dtype=np.int64)
+        totals = []
+        for start, end in itertools.pairwise(edges):
+            inside = (starts >= start) & (starts < end)
+            totals.append(
+                {
+                    "from_s": start,
+                    "to_s": end,
+                    "cost": float(cost[inside].sum()),
+                    "transmissions": int(sent[inside].sum()),
+                }
+            )
+        return totals
 
     def channel_transmission_times(self, channel: int) -> np.ndarray:
         """Transmission instants of one channel of a ``MultiBinary`` action."""
@@ -87,6 +132,7 @@ def run_episode(
         total_return += reward
         trace.time_s.append(info["time_s"])
         trace.cost.append(info["cost"])
+        trace.sent.append(int(info["transmitted"]))
         if info["transmitted"]:
             trace.transmission_times_s.append(time_before)
             trace.transmission_actions.append(np.asarray(action))
@@ -154,6 +200,7 @@ def run_parallel_episode(
         first = infos[names[0]]
         trace.time_s.append(first["time_s"])
         trace.cost.append(sum(infos[agent]["cost"] for agent in names))
+        trace.sent.append(sum(int(infos[agent]["transmitted"]) for agent in names))
         if bits.any():
             trace.transmission_times_s.append(time_before)
             trace.transmission_actions.append(bits.copy())

@@ -2,7 +2,7 @@
 
     python -m baselines.evaluate ENV_ID --policy POLICY [--policy-arg k=v ...]
         [--env-arg k=v ...] [--scenarios paper|validation|test [--set-size K]]
-        [--episodes N] [--seed S] [--json PATH|-] [--plot DIR]
+        [--episodes N] [--seed S] [--json PATH|-] [--plot DIR] [--windows T0,T1,...]
 
 POLICY is ``paper`` (the paper's triggering rule; ``--policy-arg heartbeat=H`` pairs it with a
 heartbeat, a transmission on every channel once H instants passed without one), ``error_time``
@@ -13,17 +13,21 @@ K2 at instant N), ``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines
 model). ``--scenarios`` runs a fixed scenario set of the test protocol (docs/protocol.md);
 ``--episodes/--seed`` run ad-hoc draws instead. The JSON holds every episode's record, the
 means, and the aggregates with 95 % intervals (mean, median, IQM of mean_cost, transmissions
-and return; failure rate).
+and return; failure rate). ``--windows 0,20,60,300`` splits every episode by time: each
+record gets the summed per-step cost and the transmissions of each window (``windows``), and
+the result their means over the episodes, to see where in an episode a trigger gains or loses.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
 
 from baselines.batch import process_count, run_batch, run_batch_in_processes
 from baselines.cli import (
@@ -33,7 +37,7 @@ from baselines.cli import (
     parse_assignments,
     write_json,
 )
-from baselines.episodes import mean_record
+from baselines.episodes import mean_record, window_edges
 from baselines.plotting import plot_episode
 from baselines.statistics import aggregate_lines, aggregate_records
 from etsc_envs.core.files import output_file_argument, output_folder_argument
@@ -51,6 +55,7 @@ def evaluate(
     scenarios: str | None = None,
     set_size: int = DEFAULT_SET_SIZE,
     plot_dir: str | Path | None = None,
+    windows_s: Sequence[float] | None = None,
     progress: bool = False,
     processes: int | None = None,
 ) -> dict[str, Any]:
@@ -62,16 +67,21 @@ def evaluate(
             when given, ``episodes`` and ``seed`` are not used.
         set_size: scenarios of the validation or test set.
         plot_dir: write one figure per episode (runs the episodes one by one).
+        windows_s: edges of time windows (s, at least two, strictly increasing): each record
+            gets ``windows``, the summed cost and the transmissions of each window
+            (:meth:`baselines.episodes.EpisodeTrace.window_totals`), and the result the means
+            over the episodes (runs the episodes one by one).
         processes: worker processes sharing a batch
             (:func:`baselines.batch.run_batch_in_processes`); ``None`` takes
             :func:`baselines.batch.process_count`'s, 1 runs it in this process.
 
-    Episodes without plots run at once in the id's native vector env
+    Episodes without plots or windows run at once in the id's native vector env
     (:func:`baselines.batch.run_batch`), a single one too (the paper scenario), so that a rule
     or a clock runs inside the compiled loop; the records equal the one-by-one runs'.
 
     Returns ``{"env", "policy", "policy_args", "env_args", "scenarios", "episodes": [...],
-    "mean": {...}, "aggregates": {...}}``. For a PettingZoo id
+    "mean": {...}, "aggregates": {...}}``, with ``"windows": [...]`` when ``windows_s`` is
+    given. For a PettingZoo id
     (:data:`etsc_envs.PETTINGZOO_ENV_IDS`) one policy serves every agent and the records also
     hold each agent's values under ``agents``.
     """
@@ -84,9 +94,10 @@ def evaluate(
         if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
             raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
         seeds, described = [seed + episode for episode in range(episodes)], None
+    edges = None if windows_s is None else window_edges(windows_s)
     setup = episode_setup(env_id, env_args)
     trigger = setup.make_policy(policy, policy_args)
-    if plot_dir is None:
+    if plot_dir is None and edges is None:
         setup.env.close()
         processes = process_count(len(seeds)) if processes is None else processes
         description = f"{policy} on {len(seeds)} scenario" + ("s" if len(seeds) > 1 else "")
@@ -116,12 +127,14 @@ def evaluate(
                 progress=progress,
                 description=f"{policy} episode {index + 1}/{len(seeds)}",
             )
+            if edges is not None:
+                record["windows"] = trace.window_totals(edges)
             records.append(record)
             if plot_dir is not None:
                 title = f"{env_id} - {policy} {policy_args or ''} - seed {episode_seed}"
                 plot_episode(trace, Path(plot_dir) / f"episode_{index:03d}.png", title)
         setup.env.close()
-    return {
+    result = {
         "env": env_id,
         "policy": policy,
         "policy_args": policy_args,
@@ -131,6 +144,24 @@ def evaluate(
         "mean": mean_record(records),
         "aggregates": aggregate_records(records),
     }
+    if edges is not None:
+        result["windows"] = _mean_windows(records)
+    return result
+
+
+def _mean_windows(records: list[dict[str, Any]]) -> list[dict[str, float]]:
+    """Each window's cost and transmissions averaged over the episodes' ``windows``."""
+    return [
+        {
+            "from_s": window["from_s"],
+            "to_s": window["to_s"],
+            "cost": float(np.mean([record["windows"][i]["cost"] for record in records])),
+            "transmissions": float(
+                np.mean([record["windows"][i]["transmissions"] for record in records])
+            ),
+        }
+        for i, window in enumerate(records[0]["windows"])
+    ]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -172,6 +203,13 @@ def main(argv: list[str] | None = None) -> int:
         type=output_folder_argument("--plot"),
         help="write one figure per episode",
     )
+    parser.add_argument(
+        "--windows",
+        metavar="T0,T1,...",
+        type=_window_edges_argument,
+        help="split each episode by time at these instants (s): the summed cost and the "
+        "transmissions of every window",
+    )
     args = parser.parse_args(argv)
     limit_torch_threads()
     try:
@@ -185,6 +223,7 @@ def main(argv: list[str] | None = None) -> int:
             scenarios=args.scenarios,
             set_size=args.set_size,
             plot_dir=args.plot,
+            windows_s=args.windows,
             progress=sys.stderr.isatty(),
         )
     except (ValueError, TypeError, gym.error.Error) as error:
@@ -194,6 +233,17 @@ def main(argv: list[str] | None = None) -> int:
     summary = sys.stderr if args.json == "-" else sys.stdout
     print(_summary_text(result), file=summary)
     return 0
+
+
+def _window_edges_argument(text: str) -> tuple[float, ...]:
+    """``--windows``' comma-separated seconds, checked by :func:`window_edges`."""
+    try:
+        return window_edges([float(word) for word in text.split(",")])
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            "takes at least two comma-separated times >= 0 in seconds, strictly increasing "
+            f"(e.g. 0,20,60,300), got {text!r}"
+        ) from None
 
 
 def _summary_text(result: dict[str, Any]) -> str:
@@ -212,6 +262,14 @@ def _summary_text(result: dict[str, Any]) -> str:
         lines.append(f"  {agent}: " + ", ".join(f"{k}={v:.6g}" for k, v in values.items()))
     lines.append("  aggregates (95 % intervals):")
     lines.extend(f"    {line}" for line in aggregate_lines(result["aggregates"]))
+    if "windows" in result:
+        lines.append("  windows (means over the episodes):")
+        for window in result["windows"]:
+            span = f"{window['from_s']:g}-{window['to_s']:g} s"
+            lines.append(
+                f"    {span:>16s}  cost {window['cost']:.6g}  "
+                f"transmissions {window['transmissions']:.6g}"
+            )
     return "\n".join(lines)
 
 

@@ -13,6 +13,9 @@ Checked properties:
 * ``evaluate`` returns the design page's JSON (``env``, ``policy``, ``episodes`` records with the
   required keys, ``mean``), whose ``return`` is the sum of the episode's rewards; the command
   line writes parseable JSON to stdout and turns bad input into argparse errors (exit code 2);
+* ``--windows`` / ``windows_s`` split each episode by time: the windows' summed costs and
+  transmissions add up to the episode's (a clock's are known exactly), the split episode is
+  the batch run's, and bad edges are refused naming the argument;
 * ``k=v`` arguments are read as YAML values; the reproduction report prints the paper's value
   beside ours;
 * a Stable-Baselines3 model saved by any algorithm loads back through ``load_sb3`` (algorithm
@@ -265,6 +268,60 @@ def test_evaluate_returns_the_design_page_json():
     assert json.loads(json.dumps(to_jsonable(result))) == to_jsonable(result)
 
 
+def test_evaluate_windows_split_each_episode_by_time():
+    windows = [0.0, 0.05, 0.2, 1.0]
+    result = evaluate(
+        ENV_ID,
+        "periodic",
+        policy_args={"every": 10},
+        env_args={"horizon_s": 0.2},
+        episodes=2,
+        seed=5,
+        windows_s=windows,
+    )
+    clock = {"policy_args": {"every": 10}, "env_args": {"horizon_s": 0.2}}
+    plain = evaluate(ENV_ID, "periodic", **clock, episodes=2, seed=5)
+    for episode, batch_episode in zip(result["episodes"], plain["episodes"], strict=True):
+        # Splitting runs the episode one by one; it is the batch run's episode.
+        assert episode["mean_cost"] == batch_episode["mean_cost"]
+        split = episode["windows"]
+        assert [(w["from_s"], w["to_s"]) for w in split] == [(0.0, 0.05), (0.05, 0.2), (0.2, 1.0)]
+        # A clock every 10 ms sends at 0, 10, ..., 40 ms, then at 50, ..., 190 ms; nothing after
+        # the 0.2-s horizon.
+        assert [w["transmissions"] for w in split] == [5, 15, 0]
+        assert split[2]["cost"] == 0.0
+        assert_allclose(
+            sum(w["cost"] for w in split), episode["mean_cost"] * episode["steps"], rtol=1e-12
+        )
+    # The first window's cost is the first 50 steps' summed info["cost"].
+    env = gym.make(ENV_ID, horizon_s=0.2)
+    env.reset(seed=5)
+    first = sum(env.step(int(k % 10 == 0))[4]["cost"] for k in range(50))
+    env.close()
+    assert_allclose(result["episodes"][0]["windows"][0]["cost"], first, rtol=1e-12)
+    means = result["windows"]
+    assert_allclose(
+        [w["cost"] for w in means],
+        np.mean([[w["cost"] for w in e["windows"]] for e in result["episodes"]], axis=0),
+    )
+    assert json.loads(json.dumps(to_jsonable(result))) == to_jsonable(result)
+
+
+@pytest.mark.parametrize("windows", [[1.0], [0.0, 0.0], [0.2, 0.1], [-1.0, 1.0], [0.0, np.inf]])
+def test_evaluate_refuses_bad_windows(windows):
+    with pytest.raises(ValueError, match=r"^windows_s must be"):
+        evaluate(ENV_ID, "always", env_args={"horizon_s": 0.01}, windows_s=windows)
+
+
+def test_evaluate_command_prints_the_windows(capsys):
+    argv = [ENV_ID, "--policy", "always", "--env-arg", "horizon_s=0.01", "--windows", "0,0.004,1"]
+    assert evaluate_module.main(argv) == 0
+    out = capsys.readouterr().out
+    assert "windows (means over the episodes):" in out
+    assert "0-0.004 s  cost" in out and "transmissions 4" in out
+    assert "0.004-1 s  cost" in out and "transmissions 6" in out
+
+
 def test_evaluate_command_writes_json_to_stdout(capsys):
     result = evaluate_cli(
         capsys,
@@ -306,6 +363,8 @@ SHORT = ["--env-arg", "horizon_s=0.01"]
         (["--policy", "periodic", "--policy-arg", "every=0", *SHORT], "every"),
         (["--policy", "periodic", "--policy-arg", "then_every=2", *SHORT], "together"),
         (["--policy", "periodic", "--policy-arg", "phase=2", *SHORT], "then_every=K2"),
+        (["--policy", "always", "--windows", "0.5,0.1", *SHORT], "argument --windows"),
+        (["--policy", "always", "--windows", "0;1", *SHORT], "argument --windows"),
     ],
 )
 def test_evaluate_command_reports_bad_input(capsys, argv, message):

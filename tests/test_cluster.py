@@ -671,6 +671,28 @@ def test_evaluate_reports_per_agent_values():
     assert "transmissions" in result["mean"]["agents"]["follower_2"]
 
 
+def test_evaluate_windows_add_up_over_the_agents():
+    result = evaluate(
+        PARALLEL_ID,
+        "periodic",
+        policy_args={"every": 5},
+        env_args={"horizon_s": 0.5},
+        seed=3,
+        windows_s=[0.0, 0.2, 0.5],
+    )
+    episode = result["episodes"][0]
+    split = episode["windows"]
+    # Every follower updates at steps 0, 5, 10, ... (10 ms each): 4 updates before 0.2 s and 6
+    # after, six followers.
+    assert [w["transmissions"] for w in split] == [24, 36]
+    assert (
+        sum(w["transmissions"] for w in split)
+        == episode["transmissions"]
+        == sum(agent["transmissions"] for agent in episode["agents"].values())
+    )
+    assert all(w["cost"] > 0.0 for w in split)
+
+
 def test_reproduction_report_has_the_papers_numbers():
     result = reproduction.reproduce(horizon_s=20.0)
     names = [table["name"] for table in result["tables"]]
