@@ -269,18 +269,9 @@ def test_evaluate_returns_the_design_page_json():
 
 
 def test_evaluate_windows_split_each_episode_by_time():
-    windows = [0.0, 0.05, 0.2, 1.0]
-    result = evaluate(
-        ENV_ID,
-        "periodic",
-        policy_args={"every": 10},
-        env_args={"horizon_s": 0.2},
-        episodes=2,
-        seed=5,
-        windows_s=windows,
-    )
-    clock = {"policy_args": {"every": 10}, "env_args": {"horizon_s": 0.2}}
-    plain = evaluate(ENV_ID, "periodic", **clock, episodes=2, seed=5)
+    clock = {"policy_args": {"every": 10}, "env_args": {"horizon_s": 0.2}, "episodes": 2, "seed": 5}
+    result = evaluate(ENV_ID, "periodic", **clock, windows_s=[0.0, 0.05, 0.2, 1.0])
+    plain = evaluate(ENV_ID, "periodic", **clock)
     for episode, batch_episode in zip(result["episodes"], plain["episodes"], strict=True):
         # Splitting runs the episode one by one; it is the batch run's episode.
         assert episode["mean_cost"] == batch_episode["mean_cost"]
