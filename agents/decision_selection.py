@@ -55,11 +55,11 @@ def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str
     every N instants from the first (``periodic``, ``every=N``); "paper × f" without a
     heartbeat or a floor lets the rule at f times its threshold decide every instant, the
     decision instants included, and a capped interval hands over to the same rule (the rule
-    named by the set, its thresholds scaled, with the action's heartbeat per channel if it has
-    one: ``channel_heartbeat=H``). ``None`` for a rule action with a heartbeat or a
-    floor (their stand-alone forms, where the suite has one, answer in Python every instant as
-    the decision policy does, so there is nothing to gain) and for every action of a shielded
-    set (the shield may replace a choice)."""
+    named by the set, its thresholds scaled, with the set's ``rule_keywords`` and the action's
+    heartbeat per channel if it has one: ``channel_heartbeat=H``). ``None`` for a rule action
+    with a heartbeat or a floor (their stand-alone forms, where the suite has one, answer in
+    Python every instant as the decision policy does, so there is nothing to gain) and for
+    every action of a shielded set (the shield may replace a choice)."""
     if decisions.shield_multiple is not None:
         return None
     if action < decisions.n_holds:
@@ -68,6 +68,7 @@ def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str
         return None
     index = action - decisions.n_holds
     arguments = scaled_thresholds(decisions.env_id, decisions.factors[index], decisions.rule)
+    arguments.update(decisions.rule_keywords or {})
     channel_heartbeat = decisions.channel_heartbeats[index]
     if channel_heartbeat is not None:
         arguments["channel_heartbeat"] = channel_heartbeat

@@ -82,6 +82,8 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             factor (a list), or ``None``.
         rule_channel_heartbeat: the heartbeat per channel of "paper × f, channel heartbeat H"
             actions in instants, one per factor (a list, ``None`` for none), or ``None``.
+        rule_keywords: further keywords of the rule's trigger, not scaled by the factors (for
+            000, ``a1`` and ``a2``), or ``None``.
     """
 
     def __init__(
@@ -96,6 +98,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         rule: str = "paper",
         rule_floor: int | list[int] | tuple[int, ...] | None = None,
         rule_channel_heartbeat: int | list[int | None] | tuple[int | None, ...] | None = None,
+        rule_keywords: dict[str, float] | None = None,
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -108,6 +111,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule=rule,
             rule_floor=rule_floor,
             rule_channel_heartbeat=rule_channel_heartbeat,
+            rule_keywords=rule_keywords,
         )
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
@@ -125,6 +129,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule=rule,
             rule_floor=rule_floor,
             rule_channel_heartbeat=rule_channel_heartbeat,
+            rule_keywords=rule_keywords,
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names

@@ -50,7 +50,9 @@ beside ``NAME.zip`` (:meth:`DecisionSet.save`); ``--policy sb3:NAME.zip`` then l
 
 from __future__ import annotations
 
+import inspect
 import json
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -123,6 +125,10 @@ class DecisionSet:
         rule: the family of the rule actions (:data:`etsc_envs.triggers.RULE_FAMILIES`):
             ``paper`` (the paper's trigger) or ``error_time`` (the id's error-time rule, which
             the shield does not cover); it names them (``paper x2``, ``error_time x2``).
+        rule_keywords: further keyword arguments of the rule's trigger, the same for every
+            rule action and not scaled by ``factors`` (for 000, eq. (21)'s relative thresholds
+            ``a1``, ``a2``), or ``None`` for the trigger's defaults. The names must be the
+            trigger's keywords other than the thresholds ``factors`` scales.
     """
 
     env_id: str
@@ -135,6 +141,7 @@ class DecisionSet:
     rule: str = "paper"
     rule_floor: int | tuple[int, ...] | None = None
     rule_channel_heartbeat: int | tuple[int | None, ...] | None = None
+    rule_keywords: dict[str, float] | None = None
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -201,6 +208,9 @@ class DecisionSet:
                 f"rule: no {self.rule} rule for {self.env_id}; it exists for "
                 f"{sorted(RULE_FAMILIES[self.rule][0])}"
             )
+        if self.rule_keywords is not None:
+            checked = checked_rule_keywords(self.env_id, self.rule, self.rule_keywords)
+            object.__setattr__(self, "rule_keywords", checked)
         if self.shield_multiple is None:
             return
         if self.rule != "paper" or self.rule_floor is not None:
@@ -319,6 +329,39 @@ class DecisionSet:
             raise ValueError(f"decision set {path} is not readable ({error})") from None
 
 
+def checked_rule_keywords(env_id: str, rule: str, keywords: Any) -> dict[str, float]:
+    """``keywords`` as a dict of finite numbers whose names the ``rule`` trigger of ``env_id``
+    takes besides its scaled thresholds (:func:`scaled_thresholds`); ``ValueError`` naming
+    ``rule_keywords`` and the allowed names otherwise. The values' ranges are the trigger's to
+    check when it is built."""
+    scaled = set(RULE_FAMILIES[rule][1][env_id]())
+    parameters = inspect.signature(RULE_FAMILIES[rule][0][env_id]).parameters
+    allowed = sorted(
+        name
+        for name, parameter in parameters.items()
+        if parameter.kind is inspect.Parameter.POSITIONAL_OR_KEYWORD
+        and parameter.default is not inspect.Parameter.empty
+        and name not in scaled
+    )
+    if not isinstance(keywords, Mapping) or not all(isinstance(k, str) for k in keywords):
+        raise ValueError(
+            f"rule_keywords must map keyword names to numbers (names among {allowed}) or be "
+            f"None, got {keywords!r}"
+        )
+    unknown = sorted(set(keywords) - set(allowed))
+    if unknown:
+        raise ValueError(
+            f"rule_keywords: {unknown} are not keywords of the {rule} rule of {env_id} that "
+            f"the factors leave alone; allowed: {allowed}"
+        )
+    checked = {}
+    for name, value in keywords.items():
+        if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+            raise ValueError(f"rule_keywords: {name} must be a finite number, got {value!r}")
+        checked[name] = float(value)
+    return checked
+
+
 def scaled_thresholds(env_id: str, factor: float, rule: str = "paper") -> dict[str, float]:
     """The threshold keywords of ``env_id``'s ``rule`` trigger
     (:data:`~etsc_envs.triggers.RULE_FAMILIES`) at ``factor`` times their default values."""
@@ -335,17 +378,19 @@ def scaled_rule_trigger(
     rule: str = "paper",
     floor_s: float | None = None,
     heartbeat_s: float | None = None,
+    rule_keywords: Mapping[str, float] | None = None,
 ) -> Any:
     """The ``rule`` trigger of ``env_id`` (:data:`~etsc_envs.triggers.RULE_FAMILIES`) with its
-    threshold keywords scaled by ``factor``, with a floor of ``floor_s`` seconds
-    (:func:`~etsc_envs.triggers.base.floored_trigger_class`) or a heartbeat per channel of
-    ``heartbeat_s`` seconds (:func:`~etsc_envs.triggers.base.channel_heartbeat_trigger_class`)
-    if given (not both); ``ValueError`` naming ``factors`` when the scaled values leave the
-    trigger's range."""
+    threshold keywords scaled by ``factor`` and ``rule_keywords`` (not scaled) added, with a
+    floor of ``floor_s`` seconds (:func:`~etsc_envs.triggers.base.floored_trigger_class`) or a
+    heartbeat per channel of ``heartbeat_s`` seconds
+    (:func:`~etsc_envs.triggers.base.channel_heartbeat_trigger_class`) if given (not both);
+    ``ValueError`` naming ``factors`` (and ``rule_keywords`` where given) when the values leave
+    the trigger's range."""
     if floor_s is not None and heartbeat_s is not None:
         raise ValueError("floor_s and heartbeat_s: a rule takes one of the two")
     trigger_class = RULE_FAMILIES[rule][0][env_id]
-    keywords = scaled_thresholds(env_id, factor, rule)
+    keywords = {**scaled_thresholds(env_id, factor, rule), **(rule_keywords or {})}
     if floor_s is not None:
         trigger_class = floored_trigger_class(trigger_class)
         keywords = {**keywords, "floor_s": floor_s}
@@ -355,7 +400,10 @@ def scaled_rule_trigger(
     try:
         return trigger_class(observation_space, action_space, observation_names, **keywords)
     except ValueError as error:
-        raise ValueError(f"factors: {factor:g} x the {rule} rule's threshold: {error}") from None
+        given = f" with rule_keywords {dict(rule_keywords)}" if rule_keywords else ""
+        raise ValueError(
+            f"factors: {factor:g} x the {rule} rule's threshold{given}: {error}"
+        ) from None
 
 
 class IntervalSchedule:
@@ -392,6 +440,7 @@ class IntervalSchedule:
                     None if instants is None else instants_seconds(instants, period_s)
                     for instants in (floor, heartbeat)
                 ),
+                decisions.rule_keywords,
             )
             for factor, floor, heartbeat in zip(
                 decisions.factors, decisions.floors, decisions.channel_heartbeats, strict=True

@@ -1,0 +1,114 @@
+"""A decision set's ``rule_keywords``: keywords of the rule's trigger that every rule action
+shares and the factors leave alone (for 000, eq. (21)'s relative thresholds a1, a2). They reach
+every rule action, the stand-alone form of a plain rule action and a saved set, and bad ones
+are refused by name."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import etsc_envs  # noqa: F401  (registers the ids)
+from agents.config import config_from_dict
+from agents.decision_selection import stand_alone_spec
+from agents.decisions import SelfTriggeredWrapper
+from baselines.episodes import run_episode
+from baselines.self_triggered import DecisionSet
+from tests.test_decisions import RecordedActions
+from tests.test_rule_floor import (
+    GAMMAS,
+    HORIZON_S,
+    ORBIT,
+    SAMPLING_PERIOD_S,
+    ObservationLog,
+    floored,
+)
+
+RELATIVE = {"a1": 2.4, "a2": 3.2}
+"""Eq. (21)'s a1, a2 at four times the paper's (Theorem 2 needs a1 < 3.2, a2 < 3.6)."""
+
+
+def floor_decision_actions(**decision_keywords) -> np.ndarray:
+    """The transmit/hold actions of always choosing "paper x4, floor 48"."""
+    base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
+    wrapper = SelfTriggeredWrapper(
+        base, max_exponent=8, factors=(4.0,), rule_floor=48, **decision_keywords
+    )
+    action = wrapper.decisions.action("paper x4, floor 48")
+    wrapper.reset(seed=2)
+    done = False
+    while not done:
+        _, _, terminated, truncated, _ = wrapper.step(action)
+        done = terminated or truncated
+    return np.array(base.actions)
+
+
+def test_the_keywords_reach_the_floored_rule_and_change_its_transmissions():
+    """Always choosing "paper x4, floor 48" with a1, a2 given transmits exactly where the
+    stand-alone floored rule with those a1, a2 does (sending at the first instant, as a
+    decision instant does), and not where the set without them does."""
+    with_keywords = floor_decision_actions(rule_keywords=RELATIVE)
+    reference = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
+    trigger = floored(reference, 48, **GAMMAS, **RELATIVE)
+    run_episode(reference, ObservationLog(trigger, [], first=True), 2)
+    np.testing.assert_array_equal(with_keywords, np.array(reference.actions))
+    without = floor_decision_actions()
+    assert with_keywords.sum() != without.sum()
+
+
+def test_a_plain_rule_actions_stand_alone_form_carries_the_keywords():
+    decisions = DecisionSet(ORBIT, max_exponent=3, factors=(2.0,), rule_keywords=RELATIVE)
+    spec = stand_alone_spec(decisions, decisions.action("paper x2"))
+    assert spec == ("paper", {"gamma1": 0.002, "gamma2": 0.006, **RELATIVE})
+
+
+def test_keywords_survive_a_save_and_a_load(tmp_path):
+    decisions = DecisionSet(
+        ORBIT,
+        factors=(4.0,),
+        rule_floor=64,
+        sampling_period_s=SAMPLING_PERIOD_S,
+        rule_keywords={"a1": 2, "a2": 3.2},
+    )
+    assert decisions.rule_keywords == {"a1": 2.0, "a2": 3.2}
+    decisions.save(tmp_path / "model.zip")
+    assert DecisionSet.load(tmp_path / "model.zip") == decisions
+
+
+@pytest.mark.parametrize(
+    ("keywords", "message"),
+    [
+        ({"b1": 1.0}, r"rule_keywords: \['b1'\] are not keywords .* allowed: \['a1', 'a2'\]"),
+        ({"gamma1": 0.01}, r"rule_keywords: \['gamma1'\] are not keywords"),
+        ({"a1": float("nan")}, "rule_keywords: a1 must be a finite number"),
+        ({"a1": "big"}, "rule_keywords: a1 must be a finite number"),
+        ({"a1": True}, "rule_keywords: a1 must be a finite number"),
+        ([2.4, 3.2], "rule_keywords must map keyword names to numbers"),
+    ],
+)
+def test_a_decision_set_refuses_bad_keywords(keywords, message):
+    with pytest.raises(ValueError, match=message):
+        DecisionSet(ORBIT, factors=(4.0,), rule_keywords=keywords)
+
+
+def test_a_keyword_outside_the_triggers_range_names_the_keywords():
+    env = gym.make(ORBIT, horizon_s=0.05)
+    with pytest.raises(ValueError, match=r"rule_keywords \{'a1': -1.0\}: a1 must be"):
+        SelfTriggeredWrapper(env, factors=(4.0,), rule_keywords={"a1": -1.0})
+
+
+def test_a_training_config_takes_the_keywords_and_refuses_bad_ones(tmp_path):
+    base = {
+        "env_id": ORBIT,
+        "env_kwargs": {"horizon_s": 0.05},
+        "algorithm": "PPO",
+        "policy": "MlpPolicy",
+        "total_timesteps": 32,
+        "out_dir": str(tmp_path / "run"),
+        "decisions": {"factors": [4.0], "rule_floor": 8, "rule_keywords": RELATIVE},
+    }
+    assert config_from_dict(base).decisions["rule_keywords"] == RELATIVE
+    base["decisions"]["rule_keywords"] = {"b1": 1.0}
+    with pytest.raises(ValueError, match="config key 'decisions': rule_keywords"):
+        config_from_dict(base)
