@@ -424,6 +424,7 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ({"decisions": {"max_exponent": 3, "holds": 2}}, "'decisions'"),
         ({"decisions": {"shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
         ({"decisions": {"rule": "error_time"}, "env_id": ATTITUDE}, "no error_time rule"),
+        ({"decisions": {"rule_keywords": {"b1": 1.0}}}, "config key 'decisions': rule_keywords"),
         ({"decisions": {}, "imitation_steps": 64}, "imitation_steps"),
         ({"decisions": {}, "imitation_decision": "hold 1"}, "imitation_steps"),
         ({"imitation_decision": "hold 1"}, "'imitation_decision' needs the key 'decisions'"),
