@@ -40,7 +40,7 @@ from baselines.self_triggered import (
     DecisionSet,
     IntervalSchedule,
     SelfTriggeredPolicy,
-    scaled_thresholds,
+    rule_arguments,
 )
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.protocol import scenario_set
@@ -67,8 +67,9 @@ def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str
     if decisions.rule_sends_first:
         return None
     index = action - decisions.n_holds
-    arguments = scaled_thresholds(decisions.env_id, decisions.factors[index], decisions.rule)
-    arguments.update(decisions.rule_keywords or {})
+    arguments = rule_arguments(
+        decisions.env_id, decisions.factors[index], decisions.rule, decisions.rule_keywords
+    )
     channel_heartbeat = decisions.channel_heartbeats[index]
     if channel_heartbeat is not None:
         arguments["channel_heartbeat"] = channel_heartbeat

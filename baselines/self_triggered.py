@@ -369,6 +369,18 @@ def scaled_thresholds(env_id: str, factor: float, rule: str = "paper") -> dict[s
     return {name: factor * value for name, value in thresholds.items()}
 
 
+def rule_arguments(
+    env_id: str,
+    factor: float,
+    rule: str = "paper",
+    rule_keywords: Mapping[str, float] | None = None,
+) -> dict[str, float]:
+    """The keywords of ``env_id``'s ``rule`` trigger for a "``rule`` × ``factor``" action:
+    its thresholds scaled by ``factor`` (:func:`scaled_thresholds`) and ``rule_keywords``
+    (not scaled) beside them."""
+    return {**scaled_thresholds(env_id, factor, rule), **(rule_keywords or {})}
+
+
 def scaled_rule_trigger(
     env_id: str,
     factor: float,
@@ -390,7 +402,7 @@ def scaled_rule_trigger(
     if floor_s is not None and heartbeat_s is not None:
         raise ValueError("floor_s and heartbeat_s: a rule takes one of the two")
     trigger_class = RULE_FAMILIES[rule][0][env_id]
-    keywords = {**scaled_thresholds(env_id, factor, rule), **(rule_keywords or {})}
+    keywords = rule_arguments(env_id, factor, rule, rule_keywords)
     if floor_s is not None:
         trigger_class = floored_trigger_class(trigger_class)
         keywords = {**keywords, "floor_s": floor_s}
