@@ -5,7 +5,10 @@
         [--episodes N] [--seed S] [--json PATH|-] [--plot DIR] [--windows T0,T1,...]
 
 POLICY is ``paper`` (the paper's triggering rule; ``--policy-arg heartbeat=H`` pairs it with a
-heartbeat, a transmission on every channel once H instants passed without one), ``error_time``
+heartbeat, a transmission on every channel once H instants passed without one, and
+``floor=F`` gates it with a clock, a channel transmitting only once F instants have passed
+since its last transmission; with both, as always taking the self-triggered decision
+"paper × f, floor F" whose interval cap is H), ``error_time``
 (paper 004's error-time rule, ``--policy-arg area=A`` in m·s,
 :data:`etsc_envs.triggers.ERROR_TIME_TRIGGERS`; ``heartbeat=H`` pairs it too), ``periodic``
 (``--policy-arg every=K``; with ``then_every=K2`` and ``switch_after=N`` the period becomes
