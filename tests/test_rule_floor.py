@@ -97,29 +97,6 @@ def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions(rule_fl
     assert min(lengths[:-1]) >= 48 and len(set(lengths)) > 1
 
 
-def test_the_command_lines_floored_rule_with_a_heartbeat_is_the_floor_decision():
-    """``--policy paper --policy-arg floor=48 --policy-arg heartbeat=256`` (with a1, a2 and the
-    thresholds x4) takes exactly the actions of always choosing "paper x4, floor 48" in a set
-    whose rule interval cap is 256, rule_keywords included: the command reproduces a floor
-    decision without a model."""
-    relative = {"a1": 2.4, "a2": 3.2}
-    base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
-    wrapper = SelfTriggeredWrapper(
-        base, max_exponent=8, factors=(4.0,), rule_floor=48, rule_keywords=relative
-    )
-    action = wrapper.decisions.action("paper x4, floor 48")
-    wrapper.reset(seed=3)
-    done = False
-    while not done:
-        _, _, terminated, truncated, _ = wrapper.step(action)
-        done = terminated or truncated
-    reference = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
-    arguments = {**GAMMAS, **relative, "floor": 48, "heartbeat": 256}
-    run_episode(reference, make_policy("paper", reference, arguments, ORBIT), seed=3)
-    np.testing.assert_array_equal(np.array(base.actions), np.array(reference.actions))
-    assert transmission_instants(base.actions).size > 3
-
-
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [

@@ -13,6 +13,7 @@ import etsc_envs  # noqa: F401  (registers the ids)
 from agents.config import config_from_dict
 from agents.decision_selection import stand_alone_spec
 from agents.decisions import SelfTriggeredWrapper
+from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.self_triggered import DecisionSet
 from tests.test_decision_selection import BASE_CONFIG
@@ -30,19 +31,33 @@ RELATIVE = {"a1": 2.4, "a2": 3.2}
 """Eq. (21)'s a1, a2 at four times the paper's (Theorem 2 needs a1 < 3.2, a2 < 3.6)."""
 
 
-def floor_decision_actions(**decision_keywords) -> np.ndarray:
-    """The transmit/hold actions of always choosing "paper x4, floor 48"."""
+def floor_decision_actions(floor: int = 48, **decision_keywords) -> np.ndarray:
+    """The transmit/hold actions of always choosing "paper x4, floor ``floor``"."""
     base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
     wrapper = SelfTriggeredWrapper(
-        base, max_exponent=8, factors=(4.0,), rule_floor=48, **decision_keywords
+        base, max_exponent=8, factors=(4.0,), rule_floor=floor, **decision_keywords
     )
-    action = wrapper.decisions.action("paper x4, floor 48")
+    action = wrapper.decisions.action(f"paper x4, floor {floor}")
     wrapper.reset(seed=2)
     done = False
     while not done:
         _, _, terminated, truncated, _ = wrapper.step(action)
         done = terminated or truncated
     return np.array(base.actions)
+
+
+def test_the_command_lines_floored_rule_with_a_heartbeat_is_the_floor_decision():
+    """``--policy paper --policy-arg floor=80 --policy-arg heartbeat=128`` with a1, a2 and the
+    thresholds x4 takes exactly the actions of always choosing "paper x4, floor 80" with those
+    ``rule_keywords`` in a set whose rule interval cap is 128 — the floor and the cap each end
+    some of its intervals: the command reproduces a floor decision without a model."""
+    decided = floor_decision_actions(80, rule_keywords=RELATIVE, rule_cap=128)
+    reference = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
+    arguments = {**GAMMAS, **RELATIVE, "floor": 80, "heartbeat": 128}
+    run_episode(reference, make_policy("paper", reference, arguments, ORBIT), seed=2)
+    np.testing.assert_array_equal(decided, np.array(reference.actions))
+    intervals = np.diff(np.flatnonzero(decided))
+    assert intervals.min() == 80 and intervals.max() == 128 and len(set(intervals)) > 2
 
 
 def test_the_keywords_reach_the_floored_rule_and_change_its_transmissions():
