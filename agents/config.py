@@ -68,7 +68,8 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
   ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``, ``rule_floor``,
-  ``rule_channel_heartbeat``, ``rule_keywords``; its ``gamma`` is ``hyperparameters.gamma``), on a
+  ``rule_channel_heartbeat``, ``rule_keywords``, ``holds``; its ``gamma`` is
+  ``hyperparameters.gamma``), on a
   ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
   :class:`agents.follower_decisions.FollowerDecisionEnv`; cloning with
   ``imitation_decision``). PPO, A2C and MaskablePPO then discount by elapsed instants
@@ -338,6 +339,7 @@ def _check_decisions(
         "rule_floor",
         "rule_channel_heartbeat",
         "rule_keywords",
+        "holds",
     )
     unknown = sorted(set(decisions) - set(allowed))
     if unknown:

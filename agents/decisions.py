@@ -84,6 +84,8 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             actions in instants, one per factor (a list, ``None`` for none), or ``None``.
         rule_keywords: further keywords of the rule's trigger, not scaled by the factors (for
             000, ``a1`` and ``a2``), or ``None``.
+        holds: the hold actions' lengths in instants, replacing 1, 2, ..., 2^max_exponent
+            (ascending), or ``None``.
     """
 
     def __init__(
@@ -99,6 +101,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         rule_floor: int | list[int] | tuple[int, ...] | None = None,
         rule_channel_heartbeat: int | list[int | None] | tuple[int | None, ...] | None = None,
         rule_keywords: dict[str, float] | None = None,
+        holds: list[int] | tuple[int, ...] | None = None,
     ) -> None:
         gym.utils.RecordConstructorArgs.__init__(
             self,
@@ -112,6 +115,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule_floor=rule_floor,
             rule_channel_heartbeat=rule_channel_heartbeat,
             rule_keywords=rule_keywords,
+            holds=holds,
         )
         gym.Wrapper.__init__(self, env)
         if env.spec is None:
@@ -130,6 +134,7 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
             rule_floor=rule_floor,
             rule_channel_heartbeat=rule_channel_heartbeat,
             rule_keywords=rule_keywords,
+            holds=holds,
         )
         self.schedule = IntervalSchedule(
             self.decisions, env.observation_space, env.action_space, unwrapped.observation_names

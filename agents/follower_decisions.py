@@ -56,7 +56,7 @@ class FollowerDecisionEnv(gym.Env):
         env_id: the PettingZoo id (:data:`etsc_envs.PETTINGZOO_ENV_IDS`).
         env_kwargs: its keyword arguments.
         max_exponent, factors, shield_multiple, rule_cap, rule_heartbeat, rule, rule_floor,
-            rule_channel_heartbeat, rule_keywords: the decision set's
+            rule_channel_heartbeat, rule_keywords, holds: the decision set's
             (:class:`~baselines.self_triggered.DecisionSet`; ``factors`` ``None``: the id's
             default).
         gamma: the per-instant discount within an interval (in (0, 1]).
@@ -80,6 +80,7 @@ class FollowerDecisionEnv(gym.Env):
         rule_floor: int | list[int] | tuple[int, ...] | None = None,
         rule_channel_heartbeat: int | list[int | None] | tuple[int | None, ...] | None = None,
         rule_keywords: dict[str, float] | None = None,
+        holds: list[int] | tuple[int, ...] | None = None,
         teammate_decision: str | None = None,
     ) -> None:
         if env_id not in etsc_envs.PETTINGZOO_ENV_IDS:
@@ -106,6 +107,7 @@ class FollowerDecisionEnv(gym.Env):
             rule_floor=rule_floor,
             rule_channel_heartbeat=rule_channel_heartbeat,
             rule_keywords=rule_keywords,
+            holds=holds,
         )
         self.schedule = IntervalSchedule(
             self.decisions,

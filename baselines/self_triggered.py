@@ -51,6 +51,7 @@ beside ``NAME.zip`` (:meth:`DecisionSet.save`); ``--policy sb3:NAME.zip`` then l
 from __future__ import annotations
 
 import inspect
+import itertools
 import json
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
@@ -129,6 +130,10 @@ class DecisionSet:
             rule action and not scaled by ``factors`` (for 000, eq. (21)'s relative thresholds
             ``a1``, ``a2``), or ``None`` for the trigger's defaults. The names must be the
             trigger's keywords other than the thresholds ``factors`` scales.
+        holds: the hold actions' lengths in instants (distinct integers in 1..2^20, ascending),
+            replacing 1, 2, 4, ..., 2^k (``max_exponent`` is then unused), or ``None``: a set
+            can then offer the clocks of a periodic sweep that are not powers of two (every 5,
+            10, 20 instants).
     """
 
     env_id: str
@@ -142,6 +147,7 @@ class DecisionSet:
     rule_floor: int | tuple[int, ...] | None = None
     rule_channel_heartbeat: int | tuple[int | None, ...] | None = None
     rule_keywords: dict[str, float] | None = None
+    holds: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.env_id not in PAPER_TRIGGERS:
@@ -149,6 +155,8 @@ class DecisionSet:
         exponent = self.max_exponent
         if isinstance(exponent, bool) or not isinstance(exponent, int) or not 0 <= exponent <= 20:
             raise ValueError(f"max_exponent must be an integer in 0..20, got {exponent!r}")
+        if self.holds is not None:
+            object.__setattr__(self, "holds", checked_holds(self.holds))
         given = default_factors(self.env_id) if self.factors is None else self.factors
         factors = tuple(float(f) for f in given)
         if not all(np.isfinite(f) and f > 0.0 for f in factors):
@@ -175,7 +183,7 @@ class DecisionSet:
             if floor > cap:
                 raise ValueError(
                     f"rule_floor ({floor}) must be at most its factor's longest rule interval "
-                    f"({cap}: rule_cap, else 2^max_exponent)"
+                    f"({cap}: rule_cap, else the longest hold)"
                 )
             if self.sampling_period_s is None:
                 raise ValueError("sampling_period_s must be given with rule_floor")
@@ -241,13 +249,15 @@ class DecisionSet:
 
     @property
     def hold_steps(self) -> np.ndarray:
-        """Sampling instants of each hold action: 1, 2, 4, ..., 2^k."""
+        """Sampling instants of each hold action: ``holds``, else 1, 2, 4, ..., 2^k."""
+        if self.holds is not None:
+            return np.array(self.holds)
         return 2 ** np.arange(self.max_exponent + 1)
 
     @property
     def caps(self) -> tuple[int, ...]:
         """The longest interval of each rule action in instants, in the order of ``factors``:
-        its ``rule_cap``, else 2^k."""
+        its ``rule_cap``, else the longest hold."""
         if isinstance(self.rule_cap, tuple):
             return self.rule_cap
         cap = int(self.hold_steps[-1]) if self.rule_cap is None else self.rule_cap
@@ -255,7 +265,7 @@ class DecisionSet:
 
     @property
     def n_holds(self) -> int:
-        return self.max_exponent + 1
+        return len(self.hold_steps)
 
     @property
     def action_space(self) -> gym.spaces.Discrete:
@@ -327,6 +337,21 @@ class DecisionSet:
             return cls(**record)
         except (OSError, ValueError, TypeError, KeyError) as error:
             raise ValueError(f"decision set {path} is not readable ({error})") from None
+
+
+def checked_holds(holds: Any) -> tuple[int, ...]:
+    """``holds`` as a tuple of hold lengths, or ``ValueError`` naming ``holds`` unless it is a
+    non-empty ascending list of distinct integers in 1..2^20."""
+    lengths = list(holds) if isinstance(holds, list | tuple) else []
+    integers = all(
+        not isinstance(n, bool) and isinstance(n, int) and 1 <= n <= 2**20 for n in lengths
+    )
+    if not lengths or not integers or any(b <= a for a, b in itertools.pairwise(lengths)):
+        raise ValueError(
+            f"holds must be a non-empty ascending list of distinct integers in 1..{2**20} "
+            f"(hold lengths in instants) or None, got {holds!r}"
+        )
+    return tuple(int(n) for n in lengths)
 
 
 def checked_rule_keywords(env_id: str, rule: str, keywords: Any) -> dict[str, float]:

@@ -1,0 +1,65 @@
+"""A decision set's own hold lengths (``holds``): holds of any length, such as the clocks
+every 5, 10 and 20 instants of a periodic sweep, in place of 1, 2, 4, ..., 2^k. Each hold is
+its clock, its stand-alone form is that clock, the longest hold caps the rule's intervals,
+and the lengths survive a save, a load and a training config; bad lists name ``holds``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from agents.config import config_from_dict
+from agents.decision_selection import stand_alone_spec
+from baselines.self_triggered import DecisionSet
+from etsc_envs.triggers import PeriodicPolicy
+from tests.test_decision_selection import BASE_CONFIG
+from tests.test_decisions import (
+    ATTITUDE,
+    ScriptedModel,
+    assert_same,
+    policy_actions,
+    recorded,
+    wrapper_actions,
+)
+
+HOLDS = (2, 5, 10, 20)
+
+
+def test_the_holds_are_the_actions_and_the_rule_comes_after_them():
+    decisions = DecisionSet(ATTITUDE, factors=(1.0, 4.0), holds=list(HOLDS))
+    assert decisions.holds == HOLDS
+    assert decisions.n_holds == 4 and decisions.action_space.n == 6
+    labels = [decisions.label(action) for action in range(6)]
+    assert labels == ["hold 2", "hold 5", "hold 10", "hold 20", "paper x1", "paper x4"]
+    assert decisions.caps == (20, 20)
+    assert stand_alone_spec(decisions, decisions.action("hold 10")) == (
+        "periodic",
+        {"every": 10},
+    )
+
+
+@pytest.mark.parametrize("hold", [5, 10])
+def test_a_hold_of_any_length_is_its_clock(hold):
+    env = recorded(ATTITUDE)
+    clock = PeriodicPolicy(env.observation_space, env.action_space, every=hold)
+    action = HOLDS.index(hold)
+    actions, infos = wrapper_actions(ATTITUDE, ScriptedModel(0, fixed=action), holds=HOLDS)
+    assert_same(actions, policy_actions(ATTITUDE, clock))
+    assert {info["elapsed_steps"] for info in infos[:-1]} == {hold}
+    assert np.array(actions).sum() > 5
+
+
+def test_the_holds_survive_a_save_a_load_and_a_config(tmp_path):
+    decisions = DecisionSet(ATTITUDE, factors=(1.0,), holds=HOLDS)
+    decisions.save(tmp_path / "model.zip")
+    assert DecisionSet.load(tmp_path / "model.zip") == decisions
+    config = {**BASE_CONFIG, "out_dir": str(tmp_path / "run"), "imitation_steps": 0}
+    config["decisions"] = {"holds": list(HOLDS), "factors": [1.0]}
+    config = config_from_dict(config)
+    assert config.decisions["holds"] == list(HOLDS)
+
+
+@pytest.mark.parametrize("holds", [[], [0, 5], [5, 2], [2, 2], [2.5], "10", [True]])
+def test_bad_holds_name_themselves(holds):
+    with pytest.raises(ValueError, match="holds must be a non-empty ascending list"):
+        DecisionSet(ATTITUDE, holds=holds)
