@@ -27,9 +27,8 @@ from etsc_envs.triggers import (
 from etsc_envs.triggers.base import (
     ClockTrigger,
     HeartbeatPolicy,
-    channel_heartbeat_trigger_class,
-    floored_trigger_class,
     instants_seconds,
+    timed_rule_class,
 )
 
 POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP"
@@ -222,23 +221,22 @@ def _policy_for(
         heartbeat = arguments.pop("heartbeat", None)
         channel_heartbeat = arguments.pop("channel_heartbeat", None)
         floor = arguments.pop("floor", None)
-        trigger_class = triggers[env_id]
         if channel_heartbeat is not None and floor is not None:
             raise ValueError(
                 "--policy-arg: a rule takes channel_heartbeat or floor, not both, got "
                 f"channel_heartbeat={channel_heartbeat!r} and floor={floor!r}"
             )
-        if channel_heartbeat is not None:
-            channel_heartbeat = require_int_at_least(
-                "--policy-arg channel_heartbeat", channel_heartbeat, 1
+        floor_s, heartbeat_s = (
+            None
+            if instants is None
+            else instants_seconds(
+                require_int_at_least(f"--policy-arg {name}", instants, 1),
+                loop().sampling_period_s,
             )
-            trigger_class = channel_heartbeat_trigger_class(trigger_class)
-            arguments["heartbeat_s"] = instants_seconds(channel_heartbeat, loop().sampling_period_s)
-        if floor is not None:
-            floor = require_int_at_least("--policy-arg floor", floor, 1)
-            trigger_class = floored_trigger_class(trigger_class)
-            arguments["floor_s"] = instants_seconds(floor, loop().sampling_period_s)
-        trigger = trigger_class(observation_space, action_space, names, **arguments)
+            for name, instants in (("floor", floor), ("channel_heartbeat", channel_heartbeat))
+        )
+        trigger_class, bound = timed_rule_class(triggers[env_id], floor_s, heartbeat_s)
+        trigger = trigger_class(observation_space, action_space, names, **{**arguments, **bound})
         return trigger if heartbeat is None else HeartbeatPolicy(trigger, heartbeat)
     if spec.startswith("sb3:"):
         if policy_args:

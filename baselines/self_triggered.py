@@ -67,9 +67,8 @@ from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.triggers import PAPER_SHIELDS, PAPER_TRIGGERS, RULE_FAMILIES
 from etsc_envs.triggers.base import (
     batched_observations,
-    channel_heartbeat_trigger_class,
-    floored_trigger_class,
     instants_seconds,
+    timed_rule_class,
     transmit_bits,
 )
 
@@ -424,16 +423,8 @@ def scaled_rule_trigger(
     (:func:`~etsc_envs.triggers.base.channel_heartbeat_trigger_class`) if given (not both);
     ``ValueError`` naming ``factors`` (and ``rule_keywords`` where given) when the values leave
     the trigger's range."""
-    if floor_s is not None and heartbeat_s is not None:
-        raise ValueError("floor_s and heartbeat_s: a rule takes one of the two")
-    trigger_class = RULE_FAMILIES[rule][0][env_id]
-    keywords = rule_arguments(env_id, factor, rule, rule_keywords)
-    if floor_s is not None:
-        trigger_class = floored_trigger_class(trigger_class)
-        keywords = {**keywords, "floor_s": floor_s}
-    if heartbeat_s is not None:
-        trigger_class = channel_heartbeat_trigger_class(trigger_class)
-        keywords = {**keywords, "heartbeat_s": heartbeat_s}
+    trigger_class, bound = timed_rule_class(RULE_FAMILIES[rule][0][env_id], floor_s, heartbeat_s)
+    keywords = {**rule_arguments(env_id, factor, rule, rule_keywords), **bound}
     try:
         return trigger_class(observation_space, action_space, observation_names, **keywords)
     except ValueError as error:

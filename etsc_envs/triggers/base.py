@@ -394,6 +394,24 @@ def channel_heartbeat_trigger_class(trigger_class: type[RuleTrigger]) -> type[Ru
     )
 
 
+def timed_rule_class(
+    trigger_class: type[RuleTrigger],
+    floor_s: float | None = None,
+    heartbeat_s: float | None = None,
+) -> tuple[type[RuleTrigger], dict[str, float]]:
+    """``trigger_class`` with a floor of ``floor_s`` seconds (:func:`floored_trigger_class`)
+    or a heartbeat per channel of ``heartbeat_s`` seconds
+    (:func:`channel_heartbeat_trigger_class`) where one is given, and the keyword that sets
+    that bound when the class is built (``{}`` for neither); ``ValueError`` for both."""
+    if floor_s is not None and heartbeat_s is not None:
+        raise ValueError("floor_s and heartbeat_s: a rule takes one of the two")
+    if floor_s is not None:
+        return floored_trigger_class(trigger_class), {"floor_s": floor_s}
+    if heartbeat_s is not None:
+        return channel_heartbeat_trigger_class(trigger_class), {"heartbeat_s": heartbeat_s}
+    return trigger_class, {}
+
+
 def instants_seconds(instants: int, sampling_period_s: float) -> float:
     """The time since transmission that marks ``instants`` sampling instants: a channel that
     transmitted at instant k reaches it at instant k + ``instants`` (its time since
