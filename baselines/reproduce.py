@@ -15,6 +15,7 @@ from pathlib import Path
 from baselines.cli import write_json
 from baselines.reproductions import REPRODUCTIONS
 from baselines.reproductions.report import render
+from etsc_envs.core.files import output_file_argument, output_folder_argument
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -29,8 +30,18 @@ def main(argv: list[str] | None = None) -> int:
         choices=sorted(REPRODUCTIONS),
         help="paper number (repeatable); default: all available",
     )
-    parser.add_argument("--json", metavar="PATH|-", help="write the comparison as JSON")
-    parser.add_argument("--plot", metavar="DIR", help="write the papers' figure counterparts")
+    parser.add_argument(
+        "--json",
+        metavar="PATH|-",
+        type=output_file_argument("--json"),
+        help="write the comparison as JSON",
+    )
+    parser.add_argument(
+        "--plot",
+        metavar="DIR",
+        type=output_folder_argument("--plot"),
+        help="write the papers' figure counterparts",
+    )
     parser.add_argument(
         "--strict",
         action="store_true",

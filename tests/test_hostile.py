@@ -646,3 +646,117 @@ def test_a_model_interrupted_while_being_written_is_written_whole(
     restored = PPO.load(path, device="cpu")
     for name, tensor in model.policy.state_dict().items():
         assert np.array_equal(restored.policy.state_dict()[name].numpy(), tensor.numpy())
+
+
+# ----------------------------------------------------------------------- output files (issue 41)
+def _unwritable_folder(tmp_path: Path) -> Path:
+    """A folder no file can be created in, whoever runs the test (``/proc`` refuses root too,
+    where ``os.access`` says yes)."""
+    return Path("/proc") if Path("/proc/self").is_dir() else tmp_path
+
+
+@pytest.mark.parametrize("kind", ["file", "folder"])
+def test_outputs_under_an_unwritable_place_are_refused_with_a_probe(tmp_path, kind) -> None:
+    from etsc_envs.core.files import require_writable_file, require_writable_folder
+
+    place = _unwritable_folder(tmp_path)
+    if place == tmp_path:
+        pytest.skip("no /proc on this system")
+    check = require_writable_file if kind == "file" else require_writable_folder
+    with pytest.raises(ValueError) as error:
+        check(place / "out" / "x.json", "--json")
+    assert_one_line(error, "--json", "cannot be written", "/proc")
+
+
+def test_a_folder_where_a_file_is_wanted_and_the_reverse_are_refused(tmp_path) -> None:
+    from etsc_envs.core.files import require_writable_file, require_writable_folder
+
+    (tmp_path / "file.json").write_text("x")
+    with pytest.raises(ValueError) as error:
+        require_writable_file(tmp_path, "--json")
+    assert_one_line(error, "--json must name a file")
+    with pytest.raises(ValueError) as error:
+        require_writable_folder(tmp_path / "file.json", "--plot")
+    assert_one_line(error, "--plot must name a folder")
+    with pytest.raises(ValueError) as error:
+        require_writable_folder(tmp_path / "file.json" / "plots", "--plot")
+    assert_one_line(error, "--plot", "is a file, not a folder")
+
+
+def test_a_symlinked_output_is_written_through_the_link(tmp_path) -> None:
+    from etsc_envs.core.files import atomic_write_text
+
+    real = tmp_path / "real.json"
+    real.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(real)
+    atomic_write_text(link, "new")
+    assert link.is_symlink() and real.read_text() == "new"
+
+
+def test_a_fifo_output_is_written_in_place(tmp_path) -> None:
+    import os
+    import threading
+
+    from etsc_envs.core.files import atomic_write_text, require_writable_file
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    require_writable_file(fifo, "--json")
+    received: list[str] = []
+    reader = threading.Thread(target=lambda: received.append(fifo.read_text()))
+    reader.start()
+    atomic_write_text(fifo, "through the pipe")
+    reader.join(timeout=10)
+    assert received == ["through the pipe"] and fifo.is_fifo()
+
+
+def test_dev_null_stays_a_device() -> None:
+    from etsc_envs.core.files import atomic_write_text, require_writable_file
+
+    null = Path("/dev/null")
+    if not null.is_char_device():
+        pytest.skip("no /dev/null")
+    require_writable_file(null, "--json")
+    atomic_write_text(null, "discarded")
+    assert null.is_char_device()
+
+
+def test_outputs_keep_the_umask_permissions(tmp_path) -> None:
+    import os
+    import stat
+
+    from etsc_envs.core.files import atomic_write_text
+
+    previous = os.umask(0o027)
+    try:
+        atomic_write_text(tmp_path / "new.json", "x")
+    finally:
+        os.umask(previous)
+    assert stat.S_IMODE((tmp_path / "new.json").stat().st_mode) == 0o640
+    existing = tmp_path / "existing.json"
+    existing.write_text("x")
+    existing.chmod(0o604)
+    atomic_write_text(existing, "y")
+    assert stat.S_IMODE(existing.stat().st_mode) == 0o604
+
+
+@pytest.mark.parametrize(
+    ("option", "where"),
+    [("--json", "folder"), ("--plot", "file"), ("--json", "proc")],
+)
+def test_reproduce_checks_its_outputs_before_running(tmp_path, capsys, option, where) -> None:
+    from baselines.reproduce import main
+
+    (tmp_path / "file.json").write_text("x")
+    value = {
+        "folder": str(tmp_path),
+        "file": str(tmp_path / "file.json"),
+        "proc": "/proc/x.json",
+    }[where]
+    if where == "proc" and _unwritable_folder(tmp_path) == tmp_path:
+        pytest.skip("no /proc on this system")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--paper", "002", option, value])
+    assert exit_info.value.code == 2
+    assert option in _error_line(capsys)

@@ -44,6 +44,7 @@ from etsc_envs.asteroid.gravity import (
     surface_distances,
 )
 from etsc_envs.asteroid.shape import ShapeModel
+from etsc_envs.core.files import output_folder_argument
 from etsc_envs.core.jit import jit
 
 FORMAT_VERSION = 1
@@ -437,7 +438,12 @@ def main(argv: list[str] | None = None) -> int:
         description="Regenerate the packaged Itokawa shape and gravity grid, and measure the "
         "grid's interpolation error against direct polyhedral evaluation.",
     )
-    parser.add_argument("--out", default=str(PACKAGE_DATA), help="destination folder")
+    parser.add_argument(
+        "--out",
+        default=str(PACKAGE_DATA),
+        type=output_folder_argument("--out"),
+        help="destination folder",
+    )
     parser.add_argument("--points", type=int, default=4000, help="random points for the error")
     args = parser.parse_args(argv)
     folder = Path(args.out)

@@ -26,6 +26,8 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.spatial import ConvexHull
 
+from etsc_envs.core.files import atomic_write_text, output_file_argument
+
 ITOKAWA_EXTENTS_M = (535.0, 294.0, 209.0)
 """Itokawa's overall dimensions along its long, intermediate and short axes (Fujiwara et al.,
 Science 312, 1330, 2006)."""
@@ -508,13 +510,10 @@ def _parse_tab(raw: bytes, name: str) -> tuple[list, list]:
 # --------------------------------------------------------------------------- writing
 def write_obj(shape: ShapeModel, path: str | Path) -> Path:
     """Write ``shape`` as a Wavefront OBJ file (metres, 1-based facets)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     lines = [f"# {shape.name}: {len(shape.vertices)} vertices, {len(shape.faces)} facets, metres"]
     lines += [f"v {x:.9f} {y:.9f} {z:.9f}" for x, y, z in shape.vertices]
     lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in shape.faces]
-    path.write_text("\n".join(lines) + "\n")
-    return path
+    return atomic_write_text(path, "\n".join(lines) + "\n")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -522,7 +521,12 @@ def main(argv: list[str] | None = None) -> int:
         prog="python -m etsc_envs.asteroid.shape",
         description="Write the suite's generated Itokawa shape as an OBJ file.",
     )
-    parser.add_argument("--out", required=True, help="destination .obj file")
+    parser.add_argument(
+        "--out",
+        required=True,
+        type=output_file_argument("--out", stdout=False),
+        help="destination .obj file",
+    )
     parser.add_argument("--vertices", type=int, default=PAPER_VERTEX_COUNT)
     args = parser.parse_args(argv)
     shape = itokawa_shape(args.vertices)

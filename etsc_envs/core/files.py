@@ -1,12 +1,19 @@
-"""Output files that are either written whole or not at all.
+"""Output files that are either written whole or not at all, checked before the work.
 
 Every tool of the suite that writes results (JSON, plots, models, summaries) checks the
-destination before the work starts (:func:`require_writable_file`) and writes through a
+destination before the work starts (:func:`require_writable_file`,
+:func:`require_writable_folder`): a probe file is created and removed in the folder that will
+hold the output, so a place the process cannot write (a read-only or virtual file system,
+which ``os.access`` reports as writable to root) is refused with one line, as are a folder
+where a file is wanted and a file where a folder is wanted. Files are written through a
 temporary file in the same folder followed by an atomic rename (:func:`atomic_write_text`,
 :func:`atomic_write_bytes`), so an interrupted or failed run never leaves a partly written
-file where a finished one is expected. A write that goes through a library which turns an
-interrupt into an error of its own (PyTorch's zip writer does) runs inside
-:func:`interrupts_deferred`, so Ctrl-C still ends the run as an interrupt, just after the file.
+file where a finished one is expected; a symbolic link is written through (its target is
+replaced, the link kept), a device or a FIFO (``/dev/null``, a named pipe) is written in
+place, and a new file gets the permissions the umask allows (an existing one keeps its own).
+A write that goes through a library which turns an interrupt into an error of its own
+(PyTorch's zip writer does) runs inside :func:`interrupts_deferred`, so Ctrl-C still ends the
+run as an interrupt, just after the file.
 """
 
 from __future__ import annotations
@@ -14,6 +21,7 @@ from __future__ import annotations
 import argparse
 import os
 import signal
+import stat
 import tempfile
 import threading
 from collections.abc import Callable, Iterator
@@ -21,35 +29,58 @@ from contextlib import contextmanager
 from pathlib import Path
 
 
-def require_writable_file(path: str | Path, argument: str) -> Path:
-    """``path`` as a :class:`Path` if a file can be written there, else ``ValueError`` naming
-    ``argument``: the path is a folder, or a component of its parent is a file."""
-    path = Path(path)
-    if path.is_dir():
-        raise ValueError(f"{argument} must name a file, got the folder {str(path)!r}")
+def _nearest_existing(path: Path, argument: str) -> Path:
+    """The nearest existing folder among ``path``'s parents (``path`` itself excluded), or
+    ``ValueError`` naming ``argument`` when that nearest existing one is a file."""
     for parent in path.parents:
         if parent.exists():
             if not parent.is_dir():
                 raise ValueError(
                     f"{argument} cannot be written: {str(parent)!r} is a file, not a folder"
                 )
-            if not os.access(parent, os.W_OK):
-                raise ValueError(f"{argument} cannot be written: {str(parent)!r} is read-only")
-            break
+            return parent
+    return Path.cwd()
+
+
+def _probe(folder: Path, argument: str) -> None:
+    """Create and remove a file in ``folder``, or ``ValueError`` naming ``argument`` with the
+    system's reason."""
+    try:
+        descriptor, probe = tempfile.mkstemp(prefix=".write-probe-", dir=folder)
+    except OSError as error:
+        raise ValueError(
+            f"{argument} cannot be written: no file can be created in {str(folder)!r} "
+            f"({error.strerror or type(error).__name__})"
+        ) from None
+    os.close(descriptor)
+    os.unlink(probe)
+
+
+def require_writable_file(path: str | Path, argument: str) -> Path:
+    """``path`` as a :class:`Path` if a file can be written there, else ``ValueError`` naming
+    ``argument``: the path (or the target of a link) is a folder, a component of its parent is
+    a file, or no file can be created in the folder that would hold it. An existing device or
+    FIFO passes (it is written in place)."""
+    path = Path(path)
+    target = path.resolve()
+    if target.is_dir():
+        raise ValueError(f"{argument} must name a file, got the folder {str(path)!r}")
+    if target.exists() and not target.is_file():
+        if not os.access(target, os.W_OK):
+            raise ValueError(f"{argument} cannot be written: {str(path)!r} is not writable")
+        return path
+    _probe(_nearest_existing(target, argument), argument)
     return path
 
 
 def require_writable_folder(path: str | Path, argument: str) -> Path:
-    """``path`` as a :class:`Path` if it is, or can become, a writable folder, else
-    ``ValueError`` naming ``argument``."""
+    """``path`` as a :class:`Path` if it is, or can become, a folder in which files can be
+    created, else ``ValueError`` naming ``argument``."""
     path = Path(path)
-    for candidate in (path, *path.parents):
-        if candidate.exists():
-            if not candidate.is_dir():
-                raise ValueError(f"{argument} cannot be a folder: {str(candidate)!r} is a file")
-            if not os.access(candidate, os.W_OK):
-                raise ValueError(f"{argument} cannot be written: {str(candidate)!r} is read-only")
-            break
+    target = path.resolve()
+    if target.exists() and not target.is_dir():
+        raise ValueError(f"{argument} must name a folder, got the file {str(path)!r}")
+    _probe(target if target.is_dir() else _nearest_existing(target, argument), argument)
     return path
 
 
@@ -82,17 +113,34 @@ def output_folder_argument(argument: str) -> Callable[[str], Path]:
     return checked
 
 
+def _new_file_mode() -> int:
+    """The permissions a new file gets under the process's umask (``0o666 & ~umask``)."""
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` through a temporary file and a rename (parents created)."""
+    """Write ``data`` to ``path`` through a temporary file and a rename (parents created).
+
+    A symbolic link is followed (its target is replaced, the link kept); a device or a FIFO is
+    written in place; a new file gets the umask's permissions, a replaced one keeps its own."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    target = path.resolve()
+    if target.exists() and not target.is_file() and not target.is_dir():
+        with open(target, "wb") as stream:
+            stream.write(data)
+        return path
+    target.parent.mkdir(parents=True, exist_ok=True)
+    mode = stat.S_IMODE(target.stat().st_mode) if target.is_file() else _new_file_mode()
+    descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
     try:
         with os.fdopen(descriptor, "wb") as stream:
             stream.write(data)
             stream.flush()
             os.fsync(stream.fileno())
-        os.replace(temporary, path)
+        os.chmod(temporary, mode)
+        os.replace(temporary, target)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
