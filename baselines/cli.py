@@ -19,6 +19,7 @@ from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.validation import require_int_at_least
 from etsc_envs.triggers import (
+    PAPER_TRIGGERS,
     RULE_FAMILIES,
     AlwaysPolicy,
     PeriodicPolicy,
@@ -30,8 +31,9 @@ from etsc_envs.triggers.base import (
     instants_seconds,
     timed_rule_class,
 )
+from etsc_envs.triggers.family import LearnedTrigger
 
-POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP"
+POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP | learned:PATH"
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
 (:mod:`baselines.self_triggered`)."""
 
@@ -238,6 +240,19 @@ def _policy_for(
         trigger_class, bound = timed_rule_class(triggers[env_id], floor_s, heartbeat_s)
         trigger = trigger_class(observation_space, action_space, names, **{**arguments, **bound})
         return trigger if heartbeat is None else HeartbeatPolicy(trigger, heartbeat)
+    if spec.startswith("learned:"):
+        if policy_args:
+            raise ValueError(f"--policy-arg is not used by learned triggers, got {policy_args}")
+        learned = LearnedTrigger.load(spec.removeprefix("learned:"))
+        expected = PAPER_TRIGGERS[env_id].__name__
+        if learned.family != expected:
+            raise ValueError(
+                f"--policy {spec}: a trigger of the family {learned.family!r} (learned on "
+                f"{learned.env_id}); {env_id} takes the family {expected!r}"
+            )
+        return learned.trigger(
+            observation_space, action_space, observation_names(), loop().sampling_period_s
+        )
     if spec.startswith("sb3:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")

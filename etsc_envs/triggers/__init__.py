@@ -69,6 +69,19 @@ before transmitting, at the paper's values (a larger value waits longer; paper 0
 fires more bursts with a larger α: a later burst meets a larger drift, and its saturated
 correction overshoots, docs/results.md)."""
 
+FAMILY_CLASSES = {
+    trigger.__name__: trigger
+    for trigger in (
+        AttitudeTrackingTrigger,
+        OrbitAttitudeTrigger,
+        ClusterContainmentTrigger,
+        InnerFormationTrigger,
+        AsteroidOrbitKeepingTrigger,
+    )
+}
+"""The paper trigger classes whose parametric families exist (:mod:`etsc_envs.triggers.family`),
+by class name (a learned trigger file names its family so)."""
+
 ERROR_TIME_TRIGGERS = {"etsc/InnerFormation-v0": InnerFormationErrorTimeTrigger}
 """Environment id → its error-time rule: a channel transmits when its sampling error times the
 time since its last transmission passes a threshold (:class:`InnerFormationErrorTimeTrigger`
@@ -104,6 +117,7 @@ ids whose papers give a condition under which a hold is unsafe."""
 __all__ = [
     "ERROR_TIME_THRESHOLDS",
     "ERROR_TIME_TRIGGERS",
+    "FAMILY_CLASSES",
     "PAPER_SHIELDS",
     "PAPER_THRESHOLDS",
     "PAPER_TRIGGERS",

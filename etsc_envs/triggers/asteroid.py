@@ -2,23 +2,27 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
 from etsc_envs.core.validation import require_positive
-from etsc_envs.triggers.base import RuleTrigger
+from etsc_envs.triggers.base import RuleTrigger, condition_rule
 
 PAPER_ALPHA = 0.05
 """α of eq. (15) in section 4, m²/s."""
 
 
 @jit
-def asteroid_rule(observation, indices, parameters, out):
-    """Eq. (15) on one observation: start a burst when ``barrier_m2ps`` (``indices[0]``) + α
-    (``parameters[0]``) <= 0 and no burst runs (``burst_active``, ``indices[1]``, below 0.5)."""
-    fires = observation[indices[0]] + parameters[0] <= 0.0 and observation[indices[1]] < 0.5
-    out[0] = 1 if fires else 0
+def asteroid_condition(observation, indices, parameters, statistic, threshold):
+    """Eq. (15)'s two sides on one observation: ``-barrier_m2ps`` (``indices[0]``) against α
+    (``parameters[0]``), the rule's ``barrier + α <= 0`` as ``-barrier >= α`` (the same
+    comparison: a rounded sum keeps its sign); while a burst runs (``burst_active``,
+    ``indices[1]``, at least 0.5) the threshold is infinite and nothing fires."""
+    statistic[0] = -float(observation[indices[0]])
+    threshold[0] = parameters[0] if observation[indices[1]] < 0.5 else np.inf
 
 
 class AsteroidOrbitKeepingTrigger(RuleTrigger):
@@ -51,7 +55,13 @@ class AsteroidOrbitKeepingTrigger(RuleTrigger):
             keywords={"alpha": alpha},
         )
 
-    rule = staticmethod(asteroid_rule)
+    condition = staticmethod(asteroid_condition)
+    rule = staticmethod(condition_rule(asteroid_condition, 1, False))
+    threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"alpha": ("alpha",)}
+
+    @classmethod
+    def paper_thresholds(cls) -> dict[str, float]:
+        return {"alpha": PAPER_ALPHA}
 
 
 PAPER_SHIELD_MULTIPLE = 1.0

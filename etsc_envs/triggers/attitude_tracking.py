@@ -2,21 +2,24 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.triggers.base import RuleTrigger
+from etsc_envs.triggers.base import RuleTrigger, condition_rule
 
 PAPER_PSI = 0.1
 """Ψ of Tables 1-3's first event-triggered rows (the paper also runs 1.5 and 2.5)."""
 
 
 @jit
-def attitude_tracking_rule(observation, indices, parameters, out):
-    """Eq. (27) on one observation: transmit when ``trigger_statistic`` (``indices[0]``) > Ψ
-    (``parameters[0]``)."""
-    out[0] = 1 if observation[indices[0]] > parameters[0] else 0
+def attitude_tracking_condition(observation, indices, parameters, statistic, threshold):
+    """Eq. (27)'s two sides on one observation: ``trigger_statistic`` (``indices[0]``) against
+    Ψ (``parameters[0]``); the rule transmits when the statistic is greater."""
+    statistic[0] = observation[indices[0]]
+    threshold[0] = parameters[0]
 
 
 class AttitudeTrackingTrigger(RuleTrigger):
@@ -49,4 +52,11 @@ class AttitudeTrackingTrigger(RuleTrigger):
             keywords={"psi": psi},
         )
 
-    rule = staticmethod(attitude_tracking_rule)
+    condition = staticmethod(attitude_tracking_condition)
+    strict = True
+    rule = staticmethod(condition_rule(attitude_tracking_condition, 1, True))
+    threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"psi": ("psi",)}
+
+    @classmethod
+    def paper_thresholds(cls) -> dict[str, float]:
+        return {"psi": PAPER_PSI}

@@ -85,6 +85,38 @@ def batched_rule(rule: Callable[..., None]) -> Callable[..., None]:
     return apply
 
 
+@functools.cache
+def condition_rule(
+    condition: Callable[..., None], conditions_per_channel: int, strict: bool
+) -> Callable[..., None]:
+    """The per-instant kernel ``rule(observation, indices, parameters, out)`` of a paper's
+    triggering condition written as its two sides: ``condition(observation, indices,
+    parameters, statistic, threshold)`` writes, for each of the ``C ×
+    conditions_per_channel`` conditions (channel-major), the sampling statistic and the
+    threshold it is compared with; channel c transmits when one of its conditions holds,
+    ``statistic > threshold`` if ``strict``, else ``statistic >= threshold``. The parametric
+    family (:mod:`etsc_envs.triggers.family`) compares the same two sides, weighted."""
+
+    @closure_jit
+    def rule(observation, indices, parameters, out):
+        n_conditions = out.shape[0] * conditions_per_channel
+        statistic = np.empty(n_conditions)
+        threshold = np.empty(n_conditions)
+        condition(observation, indices, parameters, statistic, threshold)
+        for channel in range(out.shape[0]):
+            fires = 0
+            for j in range(conditions_per_channel):
+                k = channel * conditions_per_channel + j
+                if strict:
+                    if statistic[k] > threshold[k]:
+                        fires = 1
+                elif statistic[k] >= threshold[k]:
+                    fires = 1
+            out[channel] = fires
+
+    return rule
+
+
 class RuleTrigger(TriggerPolicy):
     """Base of the papers' triggering rules: a stateless condition on one observation, written
     once as a compiled kernel.
@@ -107,6 +139,23 @@ class RuleTrigger(TriggerPolicy):
     """
 
     rule: ClassVar[Callable[..., None]]
+
+    condition: ClassVar[Callable[..., None] | None] = None
+    """A paper's condition as its two sides (see :func:`condition_rule`; ``rule`` is then
+    ``condition_rule(condition, conditions_per_channel, strict)``), or ``None`` for a rule
+    that is not a paper's (a clock)."""
+    conditions_per_channel: ClassVar[int] = 1
+    strict: ClassVar[bool] = False
+    threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {}
+    """The threshold keywords the parametric family scales, by factor name (one factor may
+    scale several keywords: Π for the three axes of paper 004)."""
+    factor_bounds: ClassVar[dict[str, tuple[float, float]]] = {}
+    """The factors' allowed ranges, where the paper bounds a threshold (others: (0, inf))."""
+
+    @classmethod
+    def paper_thresholds(cls) -> dict[str, float]:
+        """The keywords of :attr:`threshold_groups` at the paper's values."""
+        raise NotImplementedError(f"{cls.__name__} has no threshold keywords")
 
     def __init__(
         self,

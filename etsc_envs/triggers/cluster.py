@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.triggers.base import RuleTrigger, transmit_bits
+from etsc_envs.triggers.base import RuleTrigger, condition_rule, transmit_bits
 
 PAPER_C, PAPER_RHO, PAPER_NU = 0.6, 2.0, 0.5
 """c_i, ρ_i, ν_i of section 5.1 (the same for every follower)."""
@@ -29,16 +31,18 @@ def trigger_threshold(
 
 
 @jit
-def cluster_rule(observation, indices, parameters, out):
-    """Eq. (15) on one observation, for each of the ``n = len(out)`` followers i: fire when
-    ``event_error_i >= trigger_threshold(state_threshold_i, sqrt_lambda_min_K_i, time_s_i)``.
+def cluster_condition(observation, indices, parameters, statistic, threshold):
+    """Eq. (15)'s two sides on one observation, for each of the ``n = len(statistic)``
+    followers i: ``event_error_i`` against ``trigger_threshold(state_threshold_i,
+    sqrt_lambda_min_K_i, time_s_i)``; follower i's event fires when the error reaches it.
 
     ``indices`` holds the n indices of each of those four names in turn; ``parameters`` holds
     c, ρ, ν.
     """
-    n = out.shape[0]
+    n = statistic.shape[0]
     for i in range(n):
-        threshold = trigger_threshold(
+        statistic[i] = float(observation[indices[i]])
+        threshold[i] = trigger_threshold(
             float(observation[indices[n + i]]),
             float(observation[indices[2 * n + i]]),
             float(observation[indices[3 * n + i]]),
@@ -46,7 +50,6 @@ def cluster_rule(observation, indices, parameters, out):
             parameters[1],
             parameters[2],
         )
-        out[i] = 1 if float(observation[indices[i]]) >= threshold else 0
 
 
 class ClusterContainmentTrigger(RuleTrigger):
@@ -96,4 +99,11 @@ class ClusterContainmentTrigger(RuleTrigger):
             keywords={"c": self.c, "rho": self.rho, "nu": self.nu},
         )
 
-    rule = staticmethod(cluster_rule)
+    condition = staticmethod(cluster_condition)
+    rule = staticmethod(condition_rule(cluster_condition, 1, False))
+    threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"c": ("c",), "rho": ("rho",)}
+    factor_bounds: ClassVar[dict[str, tuple[float, float]]] = {"c": (0.0, 1.0 / PAPER_C)}
+
+    @classmethod
+    def paper_thresholds(cls) -> dict[str, float]:
+        return {"c": PAPER_C, "rho": PAPER_RHO}

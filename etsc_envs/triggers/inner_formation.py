@@ -4,6 +4,7 @@ error-time rule on the same sampling errors (a reference trigger beside the pape
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import ClassVar
 
 import gymnasium as gym
 import numpy as np
@@ -12,7 +13,7 @@ from etsc_envs.core.jit import jit
 from etsc_envs.core.validation import require_positive
 from etsc_envs.inner_formation.design import equal_share_thresholds
 from etsc_envs.inner_formation.params import InnerFormationParams
-from etsc_envs.triggers.base import RuleTrigger
+from etsc_envs.triggers.base import RuleTrigger, condition_rule
 
 AXES = ("x", "y", "z")
 
@@ -48,11 +49,13 @@ def axis_thresholds(
 
 
 @jit
-def inner_formation_rule(observation, indices, parameters, out):
-    """Eqs. (4)-(6) on one observation: axis i transmits when |r_i(t) - r_i(t_k)|
-    (``sampling_error_m_*``, ``indices[i]``) > Π_i (``parameters[i]``)."""
+def inner_formation_condition(observation, indices, parameters, statistic, threshold):
+    """Eqs. (4)-(6)'s two sides on one observation: for axis i, |r_i(t) - r_i(t_k)|
+    (``sampling_error_m_*``, ``indices[i]``) against Π_i (``parameters[i]``); the axis
+    transmits when the error is greater."""
     for axis in range(3):
-        out[axis] = 1 if abs(float(observation[indices[axis]])) > parameters[axis] else 0
+        statistic[axis] = abs(float(observation[indices[axis]]))
+        threshold[axis] = parameters[axis]
 
 
 class InnerFormationTrigger(RuleTrigger):
@@ -84,7 +87,15 @@ class InnerFormationTrigger(RuleTrigger):
             keywords={"pi1": thresholds[0], "pi2": thresholds[1], "pi3": thresholds[2]},
         )
 
-    rule = staticmethod(inner_formation_rule)
+    condition = staticmethod(inner_formation_condition)
+    strict = True
+    rule = staticmethod(condition_rule(inner_formation_condition, 1, True))
+    threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"pi": ("pi1", "pi2", "pi3")}
+
+    @classmethod
+    def paper_thresholds(cls) -> dict[str, float]:
+        pi1, pi2, pi3 = default_thresholds()
+        return {"pi1": float(pi1), "pi2": float(pi2), "pi3": float(pi3)}
 
 
 ERROR_TIME_REFERENCE_S = 0.05

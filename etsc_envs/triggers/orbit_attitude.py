@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.triggers.base import RuleTrigger
+from etsc_envs.triggers.base import RuleTrigger, condition_rule
 
 PAPER_A = (0.6, 0.8)
 """a1, a2 of section IV (Theorem 2 needs K21 = 3.2 > a1 and K22 = 3.6 > a2)."""
+THEOREM_2_K2 = (3.2, 3.6)
+"""K21, K22 of section IV: Theorem 2 needs a1 < K21 and a2 < K22."""
 PAPER_GAMMA = (0.001, 0.003)
 """γ1 (N·m), γ2 (N) of Case 1; Case 2 uses γ1 = 0.1, γ2 = 0.2."""
 
@@ -22,13 +26,13 @@ def _positive(name: str, value: float) -> float:
 
 
 @jit
-def orbit_attitude_rule(observation, indices, parameters, out):
-    """Eq. (21) on one observation: transmit when ``‖ē_cj‖ ≥ a_j ‖S̄_j‖ + γ_j`` for j = 1 or 2.
+def orbit_attitude_condition(observation, indices, parameters, statistic, threshold):
+    """Eq. (21)'s two sides on one observation, for j = 1, 2: ``‖ē_cj‖`` against
+    ``a_j ‖S̄_j‖ + γ_j``; the rule transmits when either error reaches its threshold.
 
     ``indices`` holds ``ec1_*, ec2_*`` (entries 0-5) then ``s1_*, s2_*`` (6-11);
     ``parameters`` holds a1, a2, γ1, γ2.
     """
-    fires = 0
     for j in range(2):
         error = 0.0
         surface = 0.0
@@ -37,9 +41,8 @@ def orbit_attitude_rule(observation, indices, parameters, out):
             error += component * component
             component = float(observation[indices[6 + 3 * j + axis]])
             surface += component * component
-        if np.sqrt(error) >= parameters[j] * np.sqrt(surface) + parameters[2 + j]:
-            fires = 1
-    out[0] = fires
+        statistic[j] = np.sqrt(error)
+        threshold[j] = parameters[j] * np.sqrt(surface) + parameters[2 + j]
 
 
 class OrbitAttitudeTrigger(RuleTrigger):
@@ -77,4 +80,25 @@ class OrbitAttitudeTrigger(RuleTrigger):
             keywords={"a1": a1, "a2": a2, "gamma1": gamma1, "gamma2": gamma2},
         )
 
-    rule = staticmethod(orbit_attitude_rule)
+    condition = staticmethod(orbit_attitude_condition)
+    conditions_per_channel = 2
+    rule = staticmethod(condition_rule(orbit_attitude_condition, 2, False))
+    threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {
+        "gamma1": ("gamma1",),
+        "gamma2": ("gamma2",),
+        "a1": ("a1",),
+        "a2": ("a2",),
+    }
+    factor_bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        "a1": (0.0, THEOREM_2_K2[0] / PAPER_A[0]),
+        "a2": (0.0, THEOREM_2_K2[1] / PAPER_A[1]),
+    }
+
+    @classmethod
+    def paper_thresholds(cls) -> dict[str, float]:
+        return {
+            "gamma1": PAPER_GAMMA[0],
+            "gamma2": PAPER_GAMMA[1],
+            "a1": PAPER_A[0],
+            "a2": PAPER_A[1],
+        }

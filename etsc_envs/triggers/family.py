@@ -1,0 +1,546 @@
+"""Each paper's parametric trigger family: the paper's own condition generalised by a
+parameter vector θ, one compiled kernel that the compiled loop, batch evaluation and
+``predict`` run alike.
+
+Per channel c, with τ the time since c last transmitted (the observation's
+``time_since_transmission_s*``) and, for each of the paper's conditions of that channel, its
+sampling statistic s and threshold h (:attr:`~etsc_envs.triggers.base.RuleTrigger.condition`,
+computed with every threshold keyword multiplied by its learned factor), the channel
+transmits when
+
+* τ < τ_first (the episode's first instant, where τ = 0; τ_first = T/2 or 0 for never), or
+* τ ≥ τ_max · e^{g_max} (a heartbeat), or
+* τ ≥ τ_min · e^{g_min} (a floor) and one of its conditions holds in the weighted form
+  ``s · τ^p  ⋗  h · e^{g_h} · τ_ref^p`` (⋗ the paper's own comparison, > or ≥),
+
+where p is a time exponent, τ_ref the family's reference time (:data:`REFERENCE_S`), and
+``g = (g_h, g_min, g_max)`` the output of a small state-dependent network (two tanh layers on
+the normalised observation, :class:`Modulation`), zero when it has no weights. The weighting
+is applied to both sides so that every named point is its stand-alone policy's comparison to
+the last bit: with p = 0 and g = 0 both factors are exactly 1.
+
+Named points (``tests/test_family.py`` checks each against its stand-alone policy):
+
+* the paper's rule: every factor 1, τ_min = 0, τ_max = ∞, p = 0, no first-instant send;
+* the clock every K instants: τ_min = ∞, τ_max = (K - ½) T, first-instant send;
+* the rule with a heartbeat per channel: τ_max = (H - ½) T;
+* the rule gating a clock: τ_min = (F - ½) T;
+* the rule with raised thresholds: factors other than 1 (000's a1, a2 up to Theorem 2's K2j);
+* paper 004's error-time rule |r_i - r_i(t_k)| (t - t_k) > A_i: p = 1, τ_ref = 0.05 s.
+
+Floors and heartbeats are given in sampling instants: a bound of K instants is reached K
+instants after a transmission (:func:`~etsc_envs.triggers.base.instants_seconds`).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from etsc_envs.core.jit import closure_jit
+from etsc_envs.triggers.base import (
+    RuleTrigger,
+    time_since_transmission_indices,
+    transmit_bits,
+)
+
+FORMAT = "etsc-envs/learned-trigger"
+"""The ``format`` key of a learned trigger's JSON file."""
+FORMAT_VERSION = 1
+
+MODULATION_BOUND = 3.0
+"""|g| is clipped here: the network scales a threshold or bound by at most e^3 ≈ 20 either way."""
+
+REFERENCE_S: dict[str, float] = {
+    "AttitudeTrackingTrigger": 0.05,
+    "InnerFormationTrigger": 0.05,
+    "OrbitAttitudeTrigger": 0.05,
+    "ClusterContainmentTrigger": 0.5,
+    "AsteroidOrbitKeepingTrigger": 60.0,
+}
+"""τ_ref per paper trigger class (s): about the mean interval of the paper's rule, so that p
+changes the thresholds little near it. 004's 0.05 s makes p = 1 the error-time rule at its
+default areas (Π_i × 0.05 s, :data:`~etsc_envs.triggers.inner_formation.ERROR_TIME_REFERENCE_S`)."""
+
+
+@dataclass(frozen=True)
+class Modulation:
+    """The state-dependent part of θ: ``g = clip(W3 tanh(W2 tanh(W1 x + b1) + b2) + b3)``
+    on ``x = (obs[inputs] - mean) / scale``, three outputs (threshold, floor, heartbeat).
+
+    ``inputs`` are observation names; the arrays are the layers' weights (``W1`` of shape
+    ``(h1, len(inputs))``, ``W2`` ``(h2, h1)``, ``W3`` ``(3, h2)``). All-zero weights give
+    g = 0, the plain family.
+    """
+
+    inputs: tuple[str, ...]
+    mean: np.ndarray
+    scale: np.ndarray
+    w1: np.ndarray
+    b1: np.ndarray
+    w2: np.ndarray
+    b2: np.ndarray
+    w3: np.ndarray
+    b3: np.ndarray
+
+    def __post_init__(self) -> None:
+        n_in = len(self.inputs)
+        h1, h2 = len(self.b1), len(self.b2)
+        shapes = {
+            "mean": (n_in,),
+            "scale": (n_in,),
+            "w1": (h1, n_in),
+            "w2": (h2, h1),
+            "w3": (3, h2),
+            "b3": (3,),
+        }
+        for name, shape in shapes.items():
+            value = np.asarray(getattr(self, name), dtype=np.float64)
+            if value.shape != shape or not np.all(np.isfinite(value)):
+                raise ValueError(f"modulation.{name} must be finite of shape {shape}")
+            object.__setattr__(self, name, value)
+        for name in ("b1", "b2"):
+            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=np.float64))
+        if np.any(self.scale <= 0.0):
+            raise ValueError("modulation.scale must be > 0")
+        if not 1 <= h1 <= 16 or not 1 <= h2 <= 16:
+            raise ValueError(f"modulation layers must have 1..16 units, got {h1}, {h2}")
+
+    @classmethod
+    def zeros(
+        cls, inputs: tuple[str, ...], mean: np.ndarray, scale: np.ndarray, hidden: int
+    ) -> Modulation:
+        """The modulation with all weights zero (g = 0) on ``inputs``."""
+        n = len(inputs)
+        return cls(
+            tuple(inputs),
+            np.asarray(mean, dtype=np.float64),
+            np.asarray(scale, dtype=np.float64),
+            np.zeros((hidden, n)),
+            np.zeros(hidden),
+            np.zeros((hidden, hidden)),
+            np.zeros(hidden),
+            np.zeros((3, hidden)),
+            np.zeros(3),
+        )
+
+    @property
+    def hidden(self) -> tuple[int, int]:
+        return len(self.b1), len(self.b2)
+
+    @property
+    def weights(self) -> np.ndarray:
+        """The searched weights, flat: W1, b1, W2, b2, W3, b3."""
+        return np.concatenate(
+            [a.ravel() for a in (self.w1, self.b1, self.w2, self.b2, self.w3, self.b3)]
+        )
+
+    def with_weights(self, flat: np.ndarray) -> Modulation:
+        """The same inputs and normalisation with the weights ``flat`` (see :attr:`weights`)."""
+        flat = np.asarray(flat, dtype=np.float64)
+        parts = []
+        offset = 0
+        for array in (self.w1, self.b1, self.w2, self.b2, self.w3, self.b3):
+            parts.append(flat[offset : offset + array.size].reshape(array.shape))
+            offset += array.size
+        if offset != flat.size:
+            raise ValueError(f"modulation weights: expected {offset} numbers, got {flat.size}")
+        return Modulation(self.inputs, self.mean, self.scale, *parts)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "inputs": list(self.inputs),
+            **{
+                name: getattr(self, name).tolist()
+                for name in ("mean", "scale", "w1", "b1", "w2", "b2", "w3", "b3")
+            },
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> Modulation:
+        names = ("inputs", "mean", "scale", "w1", "b1", "w2", "b2", "w3", "b3")
+        missing = [name for name in names if name not in data]
+        if missing:
+            raise ValueError(f"modulation is missing {missing}")
+        return cls(
+            tuple(str(name) for name in data["inputs"]),
+            *(np.asarray(data[name], dtype=np.float64) for name in names[1:]),
+        )
+
+
+def _non_negative_instants(name: str, value: Any) -> float:
+    value = float(value)
+    if math.isnan(value) or value < 0.0:
+        raise ValueError(f"{name} must be a number >= 0 (sampling instants; inf for none)")
+    return value
+
+
+@dataclass(frozen=True)
+class FamilyPoint:
+    """θ, one point of a paper's trigger family (see the module docstring).
+
+    Args:
+        factors: factor name (the paper trigger's ``threshold_groups``) → its multiplier of
+            the paper's threshold keywords; names left out stay at 1.
+        floor_instants: τ_min in sampling instants (0: none).
+        heartbeat_instants: τ_max in sampling instants (``inf``: none).
+        exponent: p, the time exponent of the weighted condition.
+        first_instant: send on every channel at the episode's first instant.
+        modulation: the state-dependent network, or ``None`` (g = 0).
+    """
+
+    factors: Mapping[str, float] = field(default_factory=dict)
+    floor_instants: float = 0.0
+    heartbeat_instants: float = math.inf
+    exponent: float = 0.0
+    first_instant: bool = False
+    modulation: Modulation | None = None
+
+    def __post_init__(self) -> None:
+        factors = {}
+        for name, value in dict(self.factors).items():
+            value = float(value)
+            if not math.isfinite(value) or value <= 0.0:
+                raise ValueError(f"factors.{name} must be a finite number > 0, got {value!r}")
+            factors[str(name)] = value
+        object.__setattr__(self, "factors", factors)
+        object.__setattr__(
+            self, "floor_instants", _non_negative_instants("floor_instants", self.floor_instants)
+        )
+        heartbeat = _non_negative_instants("heartbeat_instants", self.heartbeat_instants)
+        if heartbeat < 1.0:
+            raise ValueError("heartbeat_instants must be >= 1 (sampling instants; inf for none)")
+        object.__setattr__(self, "heartbeat_instants", heartbeat)
+        exponent = float(self.exponent)
+        if not math.isfinite(exponent) or abs(exponent) > 4.0:
+            raise ValueError(f"exponent must be a number in [-4, 4], got {self.exponent!r}")
+        object.__setattr__(self, "exponent", exponent)
+        object.__setattr__(self, "first_instant", bool(self.first_instant))
+
+    @classmethod
+    def clock(cls, every: int) -> FamilyPoint:
+        """The clock every ``every`` instants (:class:`~etsc_envs.triggers.base.ClockTrigger`)."""
+        return cls(floor_instants=math.inf, heartbeat_instants=every, first_instant=True)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "factors": dict(self.factors),
+            "floor_instants": _json_number(self.floor_instants),
+            "heartbeat_instants": _json_number(self.heartbeat_instants),
+            "exponent": self.exponent,
+            "first_instant": self.first_instant,
+            "modulation": None if self.modulation is None else self.modulation.to_json(),
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> FamilyPoint:
+        known = {"factors", "floor_instants", "heartbeat_instants", "exponent", "first_instant"}
+        unknown = set(data) - known - {"modulation"}
+        if unknown:
+            raise ValueError(f"point: unknown keys {sorted(unknown)}; allowed {sorted(known)}")
+        modulation = data.get("modulation")
+        return cls(
+            factors=dict(data.get("factors", {})),
+            floor_instants=_read_number(data.get("floor_instants", 0.0)),
+            heartbeat_instants=_read_number(data.get("heartbeat_instants", "inf")),
+            exponent=float(data.get("exponent", 0.0)),
+            first_instant=bool(data.get("first_instant", False)),
+            modulation=None if modulation is None else Modulation.from_json(modulation),
+        )
+
+
+def _json_number(value: float) -> float | str:
+    """``value``, with infinity as the string ``"inf"`` (JSON has no infinity)."""
+    return "inf" if math.isinf(value) else value
+
+
+def _read_number(value: Any) -> float:
+    return math.inf if value == "inf" else float(value)
+
+
+@functools.cache
+def family_rule(
+    condition: Callable[..., None], conditions_per_channel: int, strict: bool
+) -> Callable[..., None]:
+    """The compiled kernel ``rule(observation, indices, parameters, out)`` of a paper's family
+    (the module docstring's decision), over the paper's ``condition`` kernel.
+
+    ``indices`` holds the paper's indices, then the C channels' time-since-transmission
+    indices, then the network's input indices, then five counts: the paper's indices, the
+    paper's parameters, the inputs, and the two hidden widths (0 for no network).
+    ``parameters`` holds the paper's (thresholds already scaled), then τ_min, τ_max, p,
+    τ_ref, τ_first (s), then the network's mean, scale, W1, b1, W2, b2, W3, b3.
+    """
+
+    @closure_jit
+    def rule(observation, indices, parameters, out):
+        m = indices.shape[0]
+        n_rule_indices = indices[m - 5]
+        p0 = indices[m - 4]
+        n_inputs = indices[m - 3]
+        h1 = indices[m - 2]
+        h2 = indices[m - 1]
+        channels = out.shape[0]
+        g_threshold = 0.0
+        g_floor = 0.0
+        g_heartbeat = 0.0
+        if h1 > 0:
+            q = p0 + 5
+            first_input = n_rule_indices + channels
+            x = np.empty(n_inputs)
+            for i in range(n_inputs):
+                x[i] = (float(observation[indices[first_input + i]]) - parameters[q + i]) / (
+                    parameters[q + n_inputs + i]
+                )
+            q += 2 * n_inputs
+            hidden1 = np.empty(h1)
+            for j in range(h1):
+                total = parameters[q + h1 * n_inputs + j]
+                for i in range(n_inputs):
+                    total += parameters[q + j * n_inputs + i] * x[i]
+                hidden1[j] = np.tanh(total)
+            q += h1 * n_inputs + h1
+            hidden2 = np.empty(h2)
+            for j in range(h2):
+                total = parameters[q + h2 * h1 + j]
+                for i in range(h1):
+                    total += parameters[q + j * h1 + i] * hidden1[i]
+                hidden2[j] = np.tanh(total)
+            q += h2 * h1 + h2
+            g = np.empty(3)
+            for j in range(3):
+                total = parameters[q + 3 * h2 + j]
+                for i in range(h2):
+                    total += parameters[q + j * h2 + i] * hidden2[i]
+                g[j] = min(max(total, -MODULATION_BOUND), MODULATION_BOUND)
+            g_threshold = g[0]
+            g_floor = g[1]
+            g_heartbeat = g[2]
+        floor_s = parameters[p0] * np.exp(g_floor)
+        heartbeat_s = parameters[p0 + 1] * np.exp(g_heartbeat)
+        exponent = parameters[p0 + 2]
+        threshold_scale = np.exp(g_threshold) * parameters[p0 + 3] ** exponent
+        first_s = parameters[p0 + 4]
+        n_conditions = channels * conditions_per_channel
+        statistic = np.empty(n_conditions)
+        threshold = np.empty(n_conditions)
+        condition(observation, indices, parameters, statistic, threshold)
+        for channel in range(channels):
+            elapsed = float(observation[indices[n_rule_indices + channel]])
+            fires = 0
+            if elapsed < first_s or elapsed >= heartbeat_s:
+                fires = 1
+            elif elapsed >= floor_s:
+                weight = elapsed**exponent
+                for j in range(conditions_per_channel):
+                    k = channel * conditions_per_channel + j
+                    if strict:
+                        if statistic[k] * weight > threshold[k] * threshold_scale:
+                            fires = 1
+                    elif statistic[k] * weight >= threshold[k] * threshold_scale:
+                        fires = 1
+            out[channel] = fires
+
+    return rule
+
+
+def scaled_thresholds(
+    trigger_class: type[RuleTrigger], factors: Mapping[str, float]
+) -> dict[str, float]:
+    """The paper's threshold keywords of ``trigger_class`` each multiplied by its group's factor
+    (``ValueError`` naming an unknown factor or one outside the paper's bound)."""
+    groups = trigger_class.threshold_groups
+    unknown = set(factors) - set(groups)
+    if unknown:
+        raise ValueError(
+            f"factors: {sorted(unknown)} are not factors of {trigger_class.__name__}; "
+            f"allowed {sorted(groups)}"
+        )
+    for name, value in factors.items():
+        low, high = trigger_class.factor_bounds.get(name, (0.0, math.inf))
+        if not low < value < high:
+            raise ValueError(f"factors.{name} must lie in ({low:g}, {high:g}), got {value!r}")
+    paper = trigger_class.paper_thresholds()
+    return {
+        keyword: paper[keyword] * float(factors.get(name, 1.0))
+        for name, keywords in groups.items()
+        for keyword in keywords
+    }
+
+
+@functools.cache
+def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
+    """The :class:`RuleTrigger` class of ``trigger_class``'s family (one per paper, so the
+    compiled loop compiles each family once), built with ``(observation_space, action_space,
+    observation_names, point, sampling_period_s, **keywords)``: ``point`` a
+    :class:`FamilyPoint`, ``keywords`` other keywords of ``trigger_class`` that the factors
+    leave alone (paper 001's ν)."""
+    if trigger_class.condition is None:
+        raise ValueError(f"{trigger_class.__name__} has no paper condition to generalise")
+    kernel = family_rule(
+        trigger_class.condition, trigger_class.conditions_per_channel, trigger_class.strict
+    )
+
+    class FamilyTrigger(RuleTrigger):
+        rule = staticmethod(kernel)
+        paper_class = trigger_class
+
+        def __init__(
+            self,
+            observation_space: gym.Space,
+            action_space: gym.Space,
+            observation_names: tuple[str, ...],
+            point: FamilyPoint,
+            sampling_period_s: float,
+            **keywords: Any,
+        ) -> None:
+            if not isinstance(point, FamilyPoint):
+                raise ValueError(f"point must be a FamilyPoint, got {type(point).__name__}")
+            period = float(sampling_period_s)
+            if not math.isfinite(period) or period <= 0.0:
+                raise ValueError(f"sampling_period_s must be a finite number > 0, got {period!r}")
+            thresholds = scaled_thresholds(trigger_class, point.factors)
+            inner = trigger_class(
+                observation_space, action_space, observation_names, **keywords, **thresholds
+            )
+            self.point = point
+            self.inner = inner
+            names = tuple(observation_names)
+            channels = 1 if transmit_bits(action_space) is None else transmit_bits(action_space)
+            times = time_since_transmission_indices(names, channels)
+            bounds = [
+                _seconds(point.floor_instants, period),
+                _seconds(point.heartbeat_instants, period),
+                point.exponent,
+                REFERENCE_S[trigger_class.__name__],
+                0.5 * period if point.first_instant else 0.0,
+            ]
+            modulation = point.modulation
+            if modulation is None:
+                inputs: list[int] = []
+                network: list[float] = []
+                hidden = (0, 0)
+            else:
+                missing = [name for name in modulation.inputs if name not in names]
+                if missing:
+                    raise ValueError(f"modulation.inputs {missing} are not observations here")
+                inputs = [names.index(name) for name in modulation.inputs]
+                network = [
+                    *modulation.mean,
+                    *modulation.scale,
+                    *modulation.weights,
+                ]
+                hidden = modulation.hidden
+            super().__init__(
+                observation_space,
+                action_space,
+                indices=[
+                    *inner.rule_indices,
+                    *times,
+                    *inputs,
+                    len(inner.rule_indices),
+                    len(inner.rule_parameters),
+                    len(inputs),
+                    *hidden,
+                ],
+                parameters=[*inner.rule_parameters, *bounds, *network],
+                keywords={"point": point, "sampling_period_s": period, **keywords},
+            )
+
+    FamilyTrigger.__name__ = FamilyTrigger.__qualname__ = f"{trigger_class.__name__}Family"
+    return FamilyTrigger
+
+
+def _seconds(instants: float, period: float) -> float:
+    """A floor or heartbeat of ``instants`` sampling instants in seconds, as
+    :func:`~etsc_envs.triggers.base.instants_seconds` reckons it (``inf`` stays)."""
+    return math.inf if math.isinf(instants) else (instants - 0.5) * period
+
+
+@dataclass(frozen=True)
+class LearnedTrigger:
+    """A learned trigger as the file ``agents.search`` writes: the environment id, the paper
+    trigger class whose family it belongs to, the point θ, the paper trigger's other keywords,
+    and what the search recorded (penalty, seeds, scores: data for the report)."""
+
+    env_id: str
+    family: str
+    point: FamilyPoint
+    keywords: Mapping[str, Any] = field(default_factory=dict)
+    search: Mapping[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "format": FORMAT,
+            "version": FORMAT_VERSION,
+            "env_id": self.env_id,
+            "family": self.family,
+            "point": self.point.to_json(),
+            "keywords": dict(self.keywords),
+            "search": dict(self.search),
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> LearnedTrigger:
+        if not isinstance(data, Mapping) or data.get("format") != FORMAT:
+            raise ValueError(f"a learned trigger file has format {FORMAT!r}")
+        if data.get("version") != FORMAT_VERSION:
+            raise ValueError(
+                f"learned trigger version {data.get('version')!r}; this suite reads "
+                f"{FORMAT_VERSION}"
+            )
+        return cls(
+            env_id=str(data["env_id"]),
+            family=str(data["family"]),
+            point=FamilyPoint.from_json(data["point"]),
+            keywords=dict(data.get("keywords", {})),
+            search=dict(data.get("search", {})),
+        )
+
+    def save(self, path: str | Path) -> None:
+        from etsc_envs.core.files import atomic_write_text
+
+        atomic_write_text(str(path), json.dumps(self.to_json(), indent=2) + "\n")
+
+    @classmethod
+    def load(cls, path: str | Path) -> LearnedTrigger:
+        """The learned trigger in the JSON file ``path`` (``ValueError`` naming the path for a
+        file that is not one)."""
+        try:
+            data = json.loads(Path(path).read_text())
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+            raise ValueError(f"learned:{path}: not a readable JSON file ({error})") from None
+        try:
+            return cls.from_json(data)
+        except (KeyError, TypeError, ValueError) as error:
+            raise ValueError(f"learned:{path}: {error}") from None
+
+    def trigger(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        observation_names: tuple[str, ...],
+        sampling_period_s: float,
+    ) -> RuleTrigger:
+        """The trigger policy of this point for an env of these spaces and names."""
+        from etsc_envs.triggers import FAMILY_CLASSES
+
+        if self.family not in FAMILY_CLASSES:
+            raise ValueError(f"family must be one of {sorted(FAMILY_CLASSES)}, got {self.family!r}")
+        trigger_class = family_trigger_class(FAMILY_CLASSES[self.family])
+        return trigger_class(
+            observation_space,
+            action_space,
+            observation_names,
+            self.point,
+            sampling_period_s,
+            **self.keywords,
+        )

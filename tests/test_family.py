@@ -1,0 +1,251 @@
+"""The parametric trigger families (:mod:`etsc_envs.triggers.family`): each named point takes
+the decisions of its stand-alone policy, scenario for scenario and record for record, in the
+compiled loop; the kernel's decisions equal ``predict``'s; a learned file round-trips.
+
+The fast run shortens each horizon (``HORIZON_S``); ``-m slow`` runs the full horizons."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from baselines.batch import run_batch
+from etsc_envs.triggers import (
+    AsteroidOrbitKeepingTrigger,
+    AttitudeTrackingTrigger,
+    ClusterContainmentTrigger,
+    InnerFormationErrorTimeTrigger,
+    InnerFormationTrigger,
+    OrbitAttitudeTrigger,
+)
+from etsc_envs.triggers.base import (
+    ClockTrigger,
+    HeartbeatPolicy,
+    channel_heartbeat_trigger_class,
+    floored_trigger_class,
+    instants_seconds,
+)
+from etsc_envs.triggers.family import (
+    FamilyPoint,
+    LearnedTrigger,
+    Modulation,
+    family_trigger_class,
+    scaled_thresholds,
+)
+
+PAPER_CLASSES = {
+    "etsc/AttitudeTracking-v0": AttitudeTrackingTrigger,
+    "etsc/InnerFormation-v0": InnerFormationTrigger,
+    "etsc/OrbitAttitudeTracking-v0": OrbitAttitudeTrigger,
+    "etsc/ClusterContainmentCentral-v0": ClusterContainmentTrigger,
+    "etsc/AsteroidOrbitKeeping-v0": AsteroidOrbitKeepingTrigger,
+}
+
+HORIZON_S = {
+    "etsc/AttitudeTracking-v0": 10.0,
+    "etsc/InnerFormation-v0": 10.0,
+    "etsc/OrbitAttitudeTracking-v0": 10.0,
+    "etsc/ClusterContainmentCentral-v0": 100.0,
+    "etsc/AsteroidOrbitKeeping-v0": 3000.0,
+}
+"""Shortened horizons of the fast run (s); long enough for every point to transmit."""
+
+RAISED = {
+    "etsc/AttitudeTracking-v0": {"psi": 8.0},
+    "etsc/InnerFormation-v0": {"pi": 6.0},
+    "etsc/OrbitAttitudeTracking-v0": {
+        "gamma1": 4.0,
+        "gamma2": 4.0,
+        "a1": 3.1 / 0.6,
+        "a2": 3.5 / 0.8,
+    },
+    "etsc/ClusterContainmentCentral-v0": {"c": 1.65},
+    "etsc/AsteroidOrbitKeeping-v0": {"alpha": 1.0 / 16.0},
+}
+"""Each id's raised (or lowered) thresholds: its headline's factors."""
+
+SEEDS = {"paper": ([0], {"randomize": False}), "randomized": ([11, 12], {"randomize": True})}
+
+
+def _records(env_id: str, policy_builder, scenario: str, full: bool) -> list[dict]:
+    seeds, env_args = SEEDS[scenario]
+    env_args = dict(env_args)
+    if not full:
+        env_args["horizon_s"] = HORIZON_S[env_id]
+    env = gym.make(env_id, **env_args)
+    loop = env.unwrapped
+    policy = policy_builder(
+        env.observation_space, env.action_space, loop.observation_names, loop.sampling_period_s
+    )
+    env.close()
+    records = run_batch(env_id, policy, seeds, env_args)
+    for record in records:
+        record.pop("wall_time_s")
+    return records
+
+
+def _points(env_id: str) -> dict[str, tuple[FamilyPoint, object]]:
+    """Named points of ``env_id``'s family and a builder of each one's stand-alone policy."""
+    paper = PAPER_CLASSES[env_id]
+    family = family_trigger_class(paper)
+    raised = RAISED[env_id]
+    thresholds = scaled_thresholds(paper, raised)
+    points = {
+        "paper": (FamilyPoint(), lambda o, a, n, t: paper(o, a, n)),
+        "clock 7": (
+            FamilyPoint.clock(7),
+            lambda o, a, n, t: ClockTrigger(o, a, n, every=7, sampling_period_s=t),
+        ),
+        "heartbeat 40": (
+            FamilyPoint(factors=raised, heartbeat_instants=40),
+            lambda o, a, n, t: channel_heartbeat_trigger_class(paper)(
+                o, a, n, heartbeat_s=instants_seconds(40, t), **thresholds
+            ),
+        ),
+        "floor 16": (
+            FamilyPoint(factors=raised, floor_instants=16),
+            lambda o, a, n, t: floored_trigger_class(paper)(
+                o, a, n, floor_s=instants_seconds(16, t), **thresholds
+            ),
+        ),
+        "raised": (FamilyPoint(factors=raised), lambda o, a, n, t: paper(o, a, n, **thresholds)),
+    }
+    if env_id == "etsc/InnerFormation-v0":
+        points["error time x6"] = (
+            FamilyPoint(factors={"pi": 6.0}, exponent=1.0),
+            lambda o, a, n, t: InnerFormationErrorTimeTrigger(
+                o, a, n, **{f"area{i}": 6.0 * v for i, v in enumerate(_areas(), start=1)}
+            ),
+        )
+    if env_id == "etsc/AttitudeTracking-v0":
+        points["rule with heartbeat 384 (HeartbeatPolicy)"] = (
+            FamilyPoint(factors={"psi": 8.0}, heartbeat_instants=384, first_instant=True),
+            lambda o, a, n, t: HeartbeatPolicy(paper(o, a, n, psi=0.8), 384),
+        )
+    assert family  # the class is built once per paper
+    return points
+
+
+def _areas() -> np.ndarray:
+    from etsc_envs.triggers.inner_formation import default_error_time_thresholds
+
+    return default_error_time_thresholds()
+
+
+def _family(env_id: str, point: FamilyPoint):
+    family = family_trigger_class(PAPER_CLASSES[env_id])
+    return lambda o, a, n, t: family(o, a, n, point, t)
+
+
+def _check_points(env_id: str, full: bool) -> None:
+    for name, (point, stand_alone) in _points(env_id).items():
+        for scenario in SEEDS:
+            expected = _records(env_id, stand_alone, scenario, full)
+            got = _records(env_id, _family(env_id, point), scenario, full)
+            assert got == expected, f"{env_id}: the family at {name!r} ({scenario})"
+            assert sum(record["transmissions"] for record in got) > 0, name
+
+
+@pytest.mark.parametrize("env_id", sorted(PAPER_CLASSES))
+def test_named_points_equal_their_stand_alone_policies(env_id: str) -> None:
+    _check_points(env_id, full=False)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("env_id", sorted(PAPER_CLASSES))
+def test_named_points_equal_their_stand_alone_policies_full_horizon(env_id: str) -> None:
+    _check_points(env_id, full=True)
+
+
+def _modulated_point(env: gym.Env, seed: int) -> FamilyPoint:
+    names = env.unwrapped.observation_names
+    inputs = tuple(names[:4])
+    rng = np.random.default_rng(seed)
+    modulation = Modulation.zeros(inputs, np.zeros(4), np.ones(4), hidden=3)
+    modulation = modulation.with_weights(rng.normal(size=modulation.weights.size))
+    return FamilyPoint(
+        factors={"psi": 4.0},
+        floor_instants=3,
+        heartbeat_instants=200,
+        exponent=0.5,
+        modulation=modulation,
+    )
+
+
+def test_kernel_decisions_equal_predict_and_the_python_model() -> None:
+    """With a network, the compiled loop's decisions (run_batch over the rule) are predict's
+    step by step, and predict's are the module docstring's formula evaluated in NumPy."""
+    env_id = "etsc/AttitudeTracking-v0"
+    env = gym.make(env_id, horizon_s=2.0, randomize=True)
+    loop = env.unwrapped
+    point = _modulated_point(env, 0)
+    trigger = family_trigger_class(AttitudeTrackingTrigger)(
+        env.observation_space,
+        env.action_space,
+        loop.observation_names,
+        point,
+        loop.sampling_period_s,
+    )
+    obs, _ = env.reset(seed=5)
+    names = loop.observation_names
+    m = point.modulation
+    period = loop.sampling_period_s
+    sent = 0
+    done = False
+    while not done:
+        action, _ = trigger.predict(obs)
+        x = (obs[[names.index(n) for n in m.inputs]].astype(np.float64) - m.mean) / m.scale
+        g = np.clip(m.w3 @ np.tanh(m.w2 @ np.tanh(m.w1 @ x + m.b1) + m.b2) + m.b3, -3, 3)
+        tau = float(obs[names.index("time_since_transmission_s")])
+        statistic = float(obs[names.index("trigger_statistic")])
+        expected = tau >= (200 - 0.5) * period * math.exp(g[2]) or (
+            tau >= (3 - 0.5) * period * math.exp(g[1])
+            and statistic * tau**0.5 > 0.4 * math.exp(g[0]) * 0.05**0.5
+        )
+        assert bool(action) == expected
+        sent += int(action)
+        obs, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    assert sent == info["transmissions"] > 0
+    predicted = info["transmissions"]
+    batch = run_batch(env_id, trigger, [5], {"horizon_s": 2.0, "randomize": True})
+    assert batch[0]["transmissions"] == predicted
+
+
+def test_learned_file_round_trips_and_refuses_other_files(tmp_path) -> None:
+    env = gym.make("etsc/AttitudeTracking-v0")
+    point = _modulated_point(env, 1)
+    learned = LearnedTrigger("etsc/AttitudeTracking-v0", "AttitudeTrackingTrigger", point)
+    path = tmp_path / "learned.json"
+    learned.save(path)
+    loaded = LearnedTrigger.load(path)
+    assert loaded.point.to_json() == point.to_json()
+    assert json.loads(path.read_text())["format"] == "etsc-envs/learned-trigger"
+    path.write_text('{"format": "something else"}')
+    with pytest.raises(ValueError, match=r"learned:.*format"):
+        LearnedTrigger.load(path)
+
+
+@pytest.mark.parametrize(
+    ("keywords", "message"),
+    [
+        ({"factors": {"psi": -1.0}}, "factors.psi"),
+        ({"floor_instants": -1.0}, "floor_instants"),
+        ({"heartbeat_instants": 0.5}, "heartbeat_instants"),
+        ({"exponent": float("nan")}, "exponent"),
+    ],
+)
+def test_bad_points_are_refused_naming_the_argument(keywords, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        FamilyPoint(**keywords)
+
+
+def test_factors_outside_the_papers_bounds_are_refused() -> None:
+    with pytest.raises(ValueError, match=r"factors\.a1"):
+        scaled_thresholds(OrbitAttitudeTrigger, {"a1": 6.0})
+    with pytest.raises(ValueError, match="allowed"):
+        scaled_thresholds(AttitudeTrackingTrigger, {"pi": 2.0})
