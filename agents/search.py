@@ -1,0 +1,590 @@
+"""Direct policy search: CMA-ES over a paper's trigger family (:mod:`etsc_envs.triggers.family`).
+
+    python -m agents.search --config configs/search/NAME.yaml [--seed S] [--out DIR]
+                            [--processes N | --address ADDR] [--resume | --overwrite]
+
+The algorithm, in full:
+
+1. θ (the family's point) is encoded as a vector x: log2 of each searched threshold factor,
+   log2 of the floor and of the heartbeat in sampling instants (below -1: no floor; above
+   log2 of the horizon: no heartbeat), the time exponent p, and the network's weights when the
+   config searches a state-dependent modulation. x starts at the config's ``start`` point
+   (today's best hand rule, so the search begins where the menu ended).
+2. Each generation, CMA-ES (pycma) asks for ``population`` candidates. Every candidate is
+   scored on the same fresh batch of ``scenarios`` training scenarios (randomized draws whose
+   seeds lie outside the protocol's validation and test ranges) by the env's own return at the
+   penalty λ (``transmission_penalty``): ``-Σ cost_k / cost_scale - λ · transmissions``, the
+   reward the PPO triggers get, averaged over the batch. CMA-ES is told the negated returns.
+3. Every ``validate_every`` generations the distribution's mean is scored on the first
+   ``validation_size`` validation scenarios at the full horizon; the learned trigger is the
+   validated mean with the best validation return (the start point, validated at generation
+   0, competes too). The test set is never touched here.
+
+Candidates of a generation run in parallel: on a local or remote Ray cluster (the default
+where Ray is installed; ``--address`` or ``RAY_ADDRESS`` for a cluster) or in ``--processes N``
+spawned worker processes. Each generation's candidates and returns are appended to
+``generations.jsonl`` in the output folder: ``--resume`` rebuilds the CMA-ES state by replaying
+them (pycma's sampler has its own seeded generator, so asking again draws the same candidates;
+no pickle is written) and continues, and the result equals an uninterrupted run's.
+
+Writes into ``DIR`` (default ``runs/search/<config stem>_seed<S>``): ``learned.json`` (a
+``learned:`` trigger), ``curve.json`` and ``curve.png`` (training and validation returns
+against env steps and wall time), ``generations.jsonl`` and ``config.yaml``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import multiprocessing
+import os
+import sys
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from etsc_envs.core.files import atomic_write_text, output_folder_argument
+from etsc_envs.protocol import require_training_seeds, scenario_set
+from etsc_envs.triggers import FAMILY_CLASSES, PAPER_TRIGGERS
+from etsc_envs.triggers.family import FamilyPoint, LearnedTrigger, Modulation
+
+TRAINING_SEED_BASE = 10_000_000
+"""Training scenario seeds start here (above the protocol's reserved ranges): run seed S,
+generation g, scenario i draws seed ``BASE + S · 1 000 000 + g · scenarios + i``."""
+
+DIMENSIONS = ("factors", "floor", "heartbeat", "exponent", "modulation")
+"""The parts of θ a config may search."""
+
+LOG2_FACTOR_RANGE = 8.0
+"""A searched factor stays within 2^±8 of 1 (or inside the paper's bound)."""
+
+EXPONENT_RANGE = (-1.0, 2.0)
+WEIGHT_RANGE = 4.0
+STEP_SCALE = {"factors": 1.0, "floor": 1.0, "heartbeat": 1.0, "exponent": 0.25, "modulation": 0.3}
+"""Initial step size of each part, relative to ``sigma`` (x is in log2 units for the first
+three)."""
+
+
+@dataclass(frozen=True)
+class SearchConfig:
+    """A search, as its YAML file gives it (every key is checked; see configs/search/)."""
+
+    env_id: str
+    penalty: float
+    start: FamilyPoint
+    search: tuple[str, ...]
+    generations: int
+    population: int
+    scenarios: int
+    sigma: float = 1.0
+    horizon_s: float | None = None
+    validate_every: int = 5
+    validation_size: int = 16
+    hidden: int = 4
+    inputs: tuple[str, ...] = ()
+    keywords: dict[str, Any] = field(default_factory=dict)
+    seed: int = 0
+
+    @property
+    def family(self) -> type:
+        return PAPER_TRIGGERS[self.env_id]
+
+    def env_args(self, *, training: bool) -> dict[str, Any]:
+        """The env keywords of a training (shortened horizon) or a validation scenario."""
+        args: dict[str, Any] = {"transmission_penalty": self.penalty}
+        if training and self.horizon_s is not None:
+            args["horizon_s"] = self.horizon_s
+        return args
+
+
+def load_config(path: str | Path) -> SearchConfig:
+    """The search config in the YAML file ``path``; ``ValueError`` naming the key for a bad
+    value."""
+    try:
+        raw = yaml.safe_load(Path(path).read_text())
+    except (OSError, yaml.YAMLError) as error:
+        raise ValueError(f"--config {path}: {error}") from None
+    if not isinstance(raw, dict):
+        raise ValueError(f"--config {path}: a search config is a mapping of keys")
+    return config_from_dict(raw)
+
+
+def config_from_dict(raw: dict[str, Any]) -> SearchConfig:
+    allowed = {f for f in SearchConfig.__dataclass_fields__}
+    unknown = set(raw) - allowed
+    if unknown:
+        raise ValueError(
+            f"search config: unknown keys {sorted(unknown)}; allowed {sorted(allowed)}"
+        )
+    env_id = raw.get("env_id")
+    if env_id not in PAPER_TRIGGERS or PAPER_TRIGGERS[env_id].__name__ not in FAMILY_CLASSES:
+        raise ValueError(f"env_id must be one of {sorted(PAPER_TRIGGERS)}, got {env_id!r}")
+    search = tuple(raw.get("search", ()))
+    if not search or set(search) - set(DIMENSIONS):
+        raise ValueError(f"search must be a non-empty list of {DIMENSIONS}, got {list(search)}")
+    values = dict(raw)
+    values["search"] = search
+    values["start"] = FamilyPoint.from_json(raw.get("start", {}))
+    values["inputs"] = tuple(raw.get("inputs", ()))
+    for key, least in (("generations", 1), ("population", 2), ("scenarios", 1)):
+        _integer(key, values.get(key), least)
+    _integer("validate_every", values.get("validate_every", 5), 1)
+    _integer("validation_size", values.get("validation_size", 16), 1)
+    _integer("hidden", values.get("hidden", 4), 1)
+    _integer("seed", values.get("seed", 0), 0)
+    for key in ("penalty", "sigma"):
+        value = values.get(key, 1.0)
+        if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+            raise ValueError(f"{key} must be a number > 0, got {value!r}")
+        if not math.isfinite(value):
+            raise ValueError(f"{key} must be finite, got {value!r}")
+    horizon = values.get("horizon_s")
+    if horizon is not None and not (isinstance(horizon, int | float) and horizon > 0):
+        raise ValueError(f"horizon_s must be a number > 0 (s) or absent, got {horizon!r}")
+    if "modulation" in search and not values["inputs"]:
+        raise ValueError("inputs: a search of modulation names the observations it reads")
+    return SearchConfig(**values)
+
+
+def _integer(key: str, value: Any, least: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise ValueError(f"{key} must be an integer >= {least}, got {value!r}")
+    return value
+
+
+class SearchSpace:
+    """The encoding of θ as the vector CMA-ES searches (the module docstring's step 1)."""
+
+    def __init__(self, config: SearchConfig, n_steps: int, modulation: Modulation | None):
+        self.config = config
+        self.groups = tuple(config.family.threshold_groups) if "factors" in config.search else ()
+        self.no_heartbeat = math.log2(n_steps) + 1.0
+        self.modulation = modulation if "modulation" in config.search else None
+        lower: list[float] = []
+        upper: list[float] = []
+        steps: list[float] = []
+        for name in self.groups:
+            low, high = config.family.factor_bounds.get(name, (0.0, math.inf))
+            lower.append(max(-LOG2_FACTOR_RANGE, math.log2(low) if low > 0 else -math.inf))
+            upper.append(min(LOG2_FACTOR_RANGE, math.log2(high) - 1e-6))
+            steps.append(STEP_SCALE["factors"])
+        for part, low, high in (
+            ("floor", -1.0, math.log2(n_steps)),
+            ("heartbeat", 0.0, self.no_heartbeat),
+            ("exponent", *EXPONENT_RANGE),
+        ):
+            if part in config.search:
+                lower.append(low)
+                upper.append(high)
+                steps.append(STEP_SCALE[part])
+        if self.modulation is not None:
+            n = self.modulation.weights.size
+            lower += [-WEIGHT_RANGE] * n
+            upper += [WEIGHT_RANGE] * n
+            steps += [STEP_SCALE["modulation"]] * n
+        self.lower, self.upper, self.steps = np.array(lower), np.array(upper), np.array(steps)
+
+    def encode(self, point: FamilyPoint) -> np.ndarray:
+        x = [math.log2(point.factors.get(name, 1.0)) for name in self.groups]
+        if "floor" in self.config.search:
+            x.append(math.log2(point.floor_instants) if point.floor_instants >= 0.5 else -1.0)
+        if "heartbeat" in self.config.search:
+            beat = point.heartbeat_instants
+            x.append(self.no_heartbeat if math.isinf(beat) else math.log2(beat))
+        if "exponent" in self.config.search:
+            x.append(point.exponent)
+        if self.modulation is not None:
+            modulation = point.modulation or self.modulation
+            x.extend(modulation.weights)
+        return np.clip(np.array(x, dtype=float), self.lower, self.upper)
+
+    def decode(self, x: Sequence[float]) -> FamilyPoint:
+        x = np.clip(np.asarray(x, dtype=float), self.lower, self.upper)
+        start = self.config.start
+        factors = dict(start.factors)
+        i = 0
+        for name in self.groups:
+            factors[name] = float(2.0 ** x[i])
+            i += 1
+        changes: dict[str, Any] = {"factors": factors}
+        if "floor" in self.config.search:
+            changes["floor_instants"] = float(2.0 ** x[i]) if x[i] > -1.0 else 0.0
+            i += 1
+        if "heartbeat" in self.config.search:
+            changes["heartbeat_instants"] = (
+                math.inf if x[i] >= self.no_heartbeat - 1.0 else float(2.0 ** x[i])
+            )
+            i += 1
+        if "exponent" in self.config.search:
+            changes["exponent"] = float(x[i])
+            i += 1
+        if self.modulation is not None:
+            changes["modulation"] = self.modulation.with_weights(x[i:])
+        return replace(start, **changes)
+
+
+def score(
+    env_id: str, env_args: dict[str, Any], learned: dict[str, Any], seeds: list[int]
+) -> dict[str, float]:
+    """The mean return, accuracy cost and transmissions of the learned trigger ``learned`` (its
+    JSON form) over one episode per seed, all seeds in one batch
+    (:func:`baselines.batch.run_batch`). A module-level function, so that worker processes and
+    Ray tasks can run it."""
+    import gymnasium as gym
+
+    import etsc_envs
+    from baselines.batch import run_batch
+
+    trigger_file = LearnedTrigger.from_json(learned)
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env = etsc_envs.make_parallel(env_id, **env_args)
+        agent = env.possible_agents[0]
+        spaces = (env.observation_space(agent), env.action_space(agent))
+        names = tuple(env.unwrapped.agent_observation_names)
+        period = env.unwrapped.loop.sampling_period_s
+    else:
+        env = gym.make(env_id, **env_args)
+        spaces = (env.observation_space, env.action_space)
+        names = tuple(env.unwrapped.observation_names)
+        period = env.unwrapped.sampling_period_s
+    env.close()
+    trigger = trigger_file.trigger(*spaces, names, period)
+    records = run_batch(env_id, trigger, seeds, env_args)
+    return {
+        "return": float(np.mean([r["return"] for r in records])),
+        "mean_cost": float(np.mean([r["mean_cost"] for r in records])),
+        "transmissions": float(np.mean([r["transmissions"] for r in records])),
+        "failures": int(sum(r["failure"] is not None for r in records)),
+        "steps": int(sum(r["steps"] for r in records)),
+    }
+
+
+class Evaluator:
+    """Runs :func:`score` for many candidates at once: in spawned worker processes, or as Ray
+    tasks (a local Ray, or the cluster at ``address``)."""
+
+    def __init__(self, processes: int | None, address: str | None) -> None:
+        self.pool: ProcessPoolExecutor | None = None
+        self.ray: Any = None
+        if processes is not None:
+            context = multiprocessing.get_context("spawn")
+            self.pool = ProcessPoolExecutor(processes, mp_context=context)
+            self.description = f"{processes} worker process(es)"
+        else:
+            import ray
+
+            ray.init(address=address, include_dashboard=False, log_to_driver=False)
+            self.ray = ray
+            self.remote_score = ray.remote(score)
+            self.description = f"Ray at {address or 'a local cluster'}"
+
+    def map(self, calls: list[tuple[Any, ...]]) -> list[dict[str, float]]:
+        if self.pool is not None:
+            return list(self.pool.map(score, *zip(*calls, strict=True)))
+        return self.ray.get([self.remote_score.remote(*call) for call in calls])
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(cancel_futures=True)
+        if self.ray is not None:
+            self.ray.shutdown()
+
+
+def training_seeds(config: SearchConfig, generation: int) -> list[int]:
+    first = TRAINING_SEED_BASE + config.seed * 1_000_000 + generation * config.scenarios
+    require_training_seeds(first, config.scenarios, "seed")
+    return list(range(first, first + config.scenarios))
+
+
+def observation_statistics(config: SearchConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and spread of the network's inputs over two training episodes of the start point
+    (the normalisation the learned file carries); a constant input gets spread 1."""
+    import gymnasium as gym
+
+    env = gym.make(config.env_id, randomize=True, **config.env_args(training=True))
+    loop = env.unwrapped
+    names = loop.observation_names
+    trigger = LearnedTrigger(config.env_id, config.family.__name__, config.start).trigger(
+        env.observation_space, env.action_space, names, loop.sampling_period_s
+    )
+    columns = [names.index(name) for name in config.inputs]
+    rows = []
+    for seed in training_seeds(config, 0)[:2]:
+        obs, _ = env.reset(seed=seed)
+        done = False
+        while not done:
+            rows.append(obs[columns])
+            action, _ = trigger.predict(obs)
+            obs, _, terminated, truncated, _ = env.step(action)
+            done = terminated or truncated
+    env.close()
+    data = np.array(rows, dtype=np.float64)
+    spread = data.std(axis=0)
+    return data.mean(axis=0), np.where(spread > 0, spread, 1.0)
+
+
+def _learned(config: SearchConfig, point: FamilyPoint, search: dict[str, Any]) -> LearnedTrigger:
+    return LearnedTrigger(config.env_id, config.family.__name__, point, config.keywords, search)
+
+
+def run_search(
+    config: SearchConfig,
+    out: Path,
+    evaluator: Evaluator,
+    *,
+    progress: Callable[[str], None] = print,
+) -> LearnedTrigger:
+    """The search of the module docstring into ``out``, continuing the generations already
+    recorded in ``out/generations.jsonl``; returns the learned trigger."""
+    import cma
+    import gymnasium as gym
+
+    env = gym.make(config.env_id, **config.env_args(training=True))
+    n_steps = env.unwrapped.n_steps
+    env.close()
+    modulation = None
+    if "modulation" in config.search:
+        mean, spread = observation_statistics(config)
+        modulation = Modulation.zeros(config.inputs, mean, spread, config.hidden)
+    space = SearchSpace(config, n_steps, modulation)
+    start = space.decode(space.encode(config.start))
+    rng = np.random.default_rng([config.seed, 20_261_127])
+    options = {
+        "bounds": [space.lower.tolist(), space.upper.tolist()],
+        "CMA_stds": space.steps.tolist(),
+        "popsize": config.population,
+        "seed": np.nan,
+        "randn": lambda lam, n: rng.standard_normal((lam, n)),
+        "verbose": -9,
+        "maxiter": config.generations,
+    }
+    es = cma.CMAEvolutionStrategy(space.encode(start).tolist(), config.sigma, options)
+
+    log_path = out / "generations.jsonl"
+    history = (
+        [json.loads(line) for line in log_path.read_text().splitlines()]
+        if (log_path.is_file())
+        else []
+    )
+    for record in history:  # replay: the same draws, told the recorded returns
+        candidates = es.ask()
+        if not np.allclose(np.array(candidates), np.array(record["candidates"]), atol=1e-12):
+            raise ValueError(f"--resume: {log_path} was written by another config or seed")
+        es.tell(candidates, [-value for value in record["returns"]])
+
+    validation = scenario_set("validation", config.validation_size)
+    validation_args = {**validation.env_args, **config.env_args(training=False)}
+    training_args = {"randomize": True, **config.env_args(training=True)}
+    started = time.perf_counter() - (history[-1]["wall_s"] if history else 0.0)
+    steps = history[-1]["env_steps"] if history else 0
+    first = len(history)
+    session_started = time.perf_counter()
+    for generation in range(first, config.generations):
+        seeds = training_seeds(config, generation)
+        candidates = es.ask()
+        points = [space.decode(x) for x in candidates]
+        calls = [
+            (config.env_id, training_args, _learned(config, p, {}).to_json(), seeds) for p in points
+        ]
+        validate = generation % config.validate_every == 0 or generation == config.generations - 1
+        mean_point = start if generation == 0 else space.decode(es.mean)
+        if validate:
+            calls.append(
+                (
+                    config.env_id,
+                    validation_args,
+                    _learned(config, mean_point, {}).to_json(),
+                    list(validation.seeds),
+                )
+            )
+        results = evaluator.map(calls)
+        returns = [r["return"] for r in results[: len(points)]]
+        steps += sum(r["steps"] for r in results)
+        es.tell(candidates, [-value for value in returns])
+        record: dict[str, Any] = {
+            "generation": generation,
+            "candidates": [np.asarray(x).tolist() for x in candidates],
+            "returns": returns,
+            "transmissions": [r["transmissions"] for r in results[: len(points)]],
+            "mean_cost": [r["mean_cost"] for r in results[: len(points)]],
+            "env_steps": steps,
+            "wall_s": time.perf_counter() - started,
+        }
+        if validate:
+            record["validation"] = {"point": mean_point.to_json(), **results[-1]}
+        with log_path.open("a") as log:
+            log.write(json.dumps(record) + "\n")
+        history.append(record)
+        elapsed = record["wall_s"]
+        done = generation + 1
+        per_generation = (time.perf_counter() - session_started) / (done - first)
+        eta = per_generation * (config.generations - done)
+        validated = f", validation {results[-1]['return']:.4g}" if validate else ""
+        progress(
+            f"generation {done}/{config.generations}: best {max(returns):.4g}, "
+            f"mean {np.mean(returns):.4g}{validated}; {elapsed:.0f} s, about {eta:.0f} s left"
+        )
+    return finish(config, out, history)
+
+
+def finish(config: SearchConfig, out: Path, history: list[dict[str, Any]]) -> LearnedTrigger:
+    """The learned trigger (the validated mean with the best validation return), its file and
+    the search's curve, from the recorded generations."""
+    validated = [record for record in history if "validation" in record]
+    best = max(validated, key=lambda record: record["validation"]["return"])
+    curve = [
+        {
+            "generation": record["generation"],
+            "env_steps": record["env_steps"],
+            "wall_s": record["wall_s"],
+            "best_return": max(record["returns"]),
+            "mean_return": float(np.mean(record["returns"])),
+            **(
+                {
+                    "validation_return": record["validation"]["return"],
+                    "validation_cost": record["validation"]["mean_cost"],
+                    "validation_transmissions": record["validation"]["transmissions"],
+                }
+                if "validation" in record
+                else {}
+            ),
+        }
+        for record in history
+    ]
+    search = {
+        "penalty": config.penalty,
+        "seed": config.seed,
+        "generations": len(history),
+        "population": config.population,
+        "training_scenarios": config.scenarios,
+        "training_horizon_s": config.horizon_s,
+        "chosen_generation": best["generation"],
+        "validation_size": config.validation_size,
+        "validation_return": best["validation"]["return"],
+        "start_validation_return": validated[0]["validation"]["return"],
+        "env_steps": history[-1]["env_steps"],
+        "wall_s": history[-1]["wall_s"],
+    }
+    learned = _learned(config, FamilyPoint.from_json(best["validation"]["point"]), search)
+    learned.save(out / "learned.json")
+    atomic_write_text(out / "curve.json", json.dumps({"search": search, "curve": curve}, indent=2))
+    plot_curve(curve, out / "curve.png", config)
+    return learned
+
+
+def plot_curve(curve: list[dict[str, Any]], path: Path, config: SearchConfig) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(1, 2, figsize=(9, 3.4), constrained_layout=True)
+    for axis, key, label in ((axes[0], "env_steps", "env steps"), (axes[1], "wall_s", "wall (s)")):
+        axis.plot([c[key] for c in curve], [c["mean_return"] for c in curve], label="training mean")
+        axis.plot([c[key] for c in curve], [c["best_return"] for c in curve], label="training best")
+        validated = [c for c in curve if "validation_return" in c]
+        axis.plot(
+            [c[key] for c in validated],
+            [c["validation_return"] for c in validated],
+            "o-",
+            label="validation (mean point)",
+        )
+        axis.set_xlabel(label)
+        axis.set_ylabel("return per episode")
+    axes[1].legend(loc="lower right", fontsize=8)
+    figure.suptitle(f"CMA-ES on {config.env_id}, λ = {config.penalty:g}, seed {config.seed}")
+    figure.savefig(path, dpi=90)
+    plt.close(figure)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="python -m agents.search", description=__doc__.split("\n\n")[0]
+    )
+    parser.add_argument("--config", required=True, help="configs/search/NAME.yaml")
+    parser.add_argument("--seed", type=int, help="the run's seed (default: the config's)")
+    parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
+    parallel = parser.add_mutually_exclusive_group()
+    parallel.add_argument("--processes", type=int, help="worker processes instead of Ray")
+    parallel.add_argument("--address", help="a Ray cluster's address (default: RAY_ADDRESS)")
+    again = parser.add_mutually_exclusive_group()
+    again.add_argument("--resume", action="store_true", help="continue the run in --out")
+    again.add_argument("--overwrite", action="store_true", help="start --out afresh")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        config = load_config(args.config)
+        if args.seed is not None:
+            config = replace(config, seed=_integer("--seed", args.seed, 0))
+        if args.processes is not None:
+            _integer("--processes", args.processes, 1)
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    out = args.out or Path("runs/search") / f"{Path(args.config).stem}_seed{config.seed}"
+    log_path = out / "generations.jsonl"
+    if log_path.exists() and not (args.resume or args.overwrite):
+        print(
+            f"error: --out {out} holds a search; --resume continues it, --overwrite starts afresh",
+            file=sys.stderr,
+        )
+        return 2
+    out.mkdir(parents=True, exist_ok=True)
+    from filelock import FileLock, Timeout
+
+    lock = FileLock(str(out / ".search.lock"))
+    try:
+        lock.acquire(timeout=0)
+    except Timeout:
+        print(f"error: --out {out} is in use by another search", file=sys.stderr)
+        return 2
+    evaluator = None
+    try:
+        if args.overwrite and log_path.exists():
+            log_path.unlink()
+        settings = yaml.safe_dump(
+            {**yaml.safe_load(Path(args.config).read_text()), "seed": config.seed}
+        )
+        atomic_write_text(out / "config.yaml", settings)
+        processes = args.processes
+        if processes is None and args.address is None and not os.environ.get("RAY_ADDRESS"):
+            try:
+                import ray  # noqa: F401
+            except ImportError:
+                processes = os.cpu_count() or 1
+        evaluator = Evaluator(processes, args.address)
+        print(
+            f"CMA-ES on {config.env_id} (λ = {config.penalty:g}, seed {config.seed}): "
+            f"{config.generations} generations of {config.population} on {evaluator.description}"
+            f"; writing {out}",
+            flush=True,
+        )
+        learned = run_search(config, out, evaluator, progress=lambda line: print(line, flush=True))
+    except KeyboardInterrupt:
+        print(
+            f"interrupted; the finished generations are in {log_path}: run the same command with "
+            "--resume to continue",
+            file=sys.stderr,
+        )
+        return 130
+    finally:
+        if evaluator is not None:
+            evaluator.close()
+        lock.release()
+    chosen = learned.search["chosen_generation"]
+    print(f"learned trigger: {out / 'learned.json'} (the mean of generation {chosen})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
