@@ -148,6 +148,14 @@ def clock_verdict(
     return result
 
 
+def model_spec(model: str) -> str:
+    """The ``--policy`` of a ``--model``: as given with a ``sb3:`` or ``learned:`` prefix, a
+    learned trigger for a ``.json`` file, else an SB3 zip."""
+    if model.startswith(("sb3:", "learned:")):
+        return model
+    return f"learned:{model}" if model.endswith(".json") else f"sb3:{model}"
+
+
 def _compare_set(
     env_id: str,
     models: list[str],
@@ -176,7 +184,7 @@ def _compare_set(
     learned_rows = []
     clocks: dict[int, dict[str, Any]] = {}  # one run per period: seeds often share their rate
     for model in models:
-        learned = run(f"sb3:{model}")
+        learned = run(model_spec(model))
         every = equal_rate_period(
             learned["mean"]["steps"], learned["mean"]["transmissions"], channels
         )
@@ -261,12 +269,12 @@ def compare(
 ) -> dict[str, Any]:
     """The comparison of the module docstring, as a JSON-ready mapping."""
     if not models:
-        raise ValueError("--model must name at least one SB3 zip")
+        raise ValueError("--model must name at least one SB3 zip or learned trigger")
     for name in scenario_sets:
         if name not in SCENARIO_SET_NAMES:
             raise ValueError(f"--scenarios must be among {SCENARIO_SET_NAMES}, got {name!r}")
     env_args = dict(env_args or {})
-    require_policies(env_id, env_args, [f"sb3:{model}" for model in models])
+    require_policies(env_id, env_args, [model_spec(model) for model in models])
     return {
         "env": env_id,
         "models": list(models),
@@ -398,7 +406,8 @@ def main(argv: list[str] | None = None) -> int:
         "--model",
         action="append",
         default=[],
-        help="an SB3 zip of the learned trigger (repeat for several training seeds)",
+        help="an SB3 zip or a learned trigger (learned:PATH or a .json file); repeat for "
+        "several training or search seeds",
     )
     parser.add_argument(
         "--sweep",
