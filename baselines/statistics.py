@@ -152,6 +152,40 @@ def paired_ratio(candidate: Sequence[float], reference: Sequence[float]) -> dict
     return result
 
 
+def _stratified_bootstrap(
+    scores: np.ndarray, statistic: Callable[[np.ndarray], np.ndarray], task_bootstrap: bool
+) -> tuple[float, list[float]]:
+    """rliable's stratified bootstrap of ``statistic`` over ``(runs, scenarios)`` scores: the
+    point estimate and its percentile interval.
+
+    rliable draws its resamples from NumPy's global generator (``np.random.choice``), not from
+    the ``random_state`` it hands to arch, so the global generator is seeded with
+    :data:`BOOTSTRAP_SEED` for the call and restored after it: the interval is then the same in
+    every process.
+    """
+    from rliable import library as rly
+
+    state = np.random.get_state()
+    np.random.seed(BOOTSTRAP_SEED)
+    try:
+        with warnings.catch_warnings():
+            # arch 7 deprecates the random_state keyword rliable passes (rliable keeps arch
+            # below 8, where it is gone)
+            warnings.filterwarnings("ignore", "random_state is deprecated", FutureWarning)
+            point, interval = rly.get_interval_estimates(
+                {"scores": scores},
+                statistic,
+                task_bootstrap=task_bootstrap,
+                reps=BOOTSTRAP_RESAMPLES,
+                confidence_interval_size=CONFIDENCE,
+                random_state=np.random.RandomState(BOOTSTRAP_SEED),
+            )
+    finally:
+        np.random.set_state(state)
+    bounds = interval["scores"]
+    return float(point["scores"][0]), [float(bounds[0, 0]), float(bounds[1, 0])]
+
+
 def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
     """Several training runs of a method against a reference trigger on the same scenarios.
 
@@ -165,7 +199,6 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
     is 1, and a scenario where a run is above a zero reference leaves the ratios and is counted
     in ``worse_where_reference_zero``.
     """
-    from rliable import library as rly
     from rliable import metrics
 
     a = np.atleast_2d(np.asarray(candidate, dtype=float))
@@ -175,28 +208,48 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
         raise ValueError("no scenario has a ratio: the reference is 0 wherever a run is not")
     kept_a, kept_b = a[:, ~worse], b[:, ~worse]
     ratios = np.where(kept_b == 0.0, 1.0, kept_a / np.where(kept_b == 0.0, 1.0, kept_b))
-    with warnings.catch_warnings():
-        # rliable seeds arch's bootstrap through random_state, which arch 7 deprecates (and
-        # rliable keeps arch below 8, where it is gone): the seed still takes effect.
-        warnings.filterwarnings("ignore", "random_state is deprecated", FutureWarning)
-        point, interval = rly.get_interval_estimates(
-            {"ratio": ratios},
-            lambda scores: np.array([metrics.aggregate_iqm(scores)]),
-            task_bootstrap=True,
-            reps=BOOTSTRAP_RESAMPLES,
-            confidence_interval_size=CONFIDENCE,
-            random_state=np.random.RandomState(BOOTSTRAP_SEED),
-        )
+    point, interval = _stratified_bootstrap(
+        ratios, lambda scores: np.array([metrics.aggregate_iqm(scores)]), task_bootstrap=True
+    )
     per_run = [float(value) for value in iqm(ratios, axis=1)]
     return {
         "runs": int(a.shape[0]),
         "n": int(a.shape[1]),
-        "iqm": float(point["ratio"][0]),
-        "iqm_ci95": [float(interval["ratio"][0, 0]), float(interval["ratio"][1, 0])],
+        "iqm": point,
+        "iqm_ci95": interval,
         "per_run": per_run,
         "range": [min(per_run), max(per_run)],
         "worse_where_reference_zero": int(worse.sum()),
     }
+
+
+def seeds_summary(values: np.ndarray) -> dict[str, Any]:
+    """The mean of several training runs' per-scenario values, over runs × scenarios.
+
+    Args:
+        values: ``(runs, scenarios)`` values of one method (one row per training seed).
+
+    Returns ``runs``, ``n`` (scenarios), ``mean`` and ``mean_ci95``: with one run the
+    percentile bootstrap interval over scenarios (:func:`summarize`); with several, rliable's
+    stratified bootstrap interval resampling the scenarios and the runs within each
+    (``task_bootstrap``, as :func:`seeds_ratio`), so one scenario's interval spans the seeds.
+    A single value has the degenerate interval at itself.
+    """
+    sample = np.atleast_2d(np.asarray(values, dtype=float))
+    if sample.size == 0 or sample.ndim != 2 or not np.all(np.isfinite(sample)):
+        raise ValueError(
+            f"values must be a (runs, scenarios) array of finite numbers, got {values!r}"
+        )
+    runs, scenarios = sample.shape
+    if runs == 1:
+        interval = _bootstrap_interval((sample[0],), np.mean)
+    elif np.ptp(sample) == 0.0:
+        interval = [float(sample[0, 0])] * 2
+    else:
+        _, interval = _stratified_bootstrap(
+            sample, lambda scores: np.array([np.mean(scores)]), task_bootstrap=scenarios > 1
+        )
+    return {"runs": runs, "n": scenarios, "mean": float(sample.mean()), "mean_ci95": interval}
 
 
 AGGREGATED_KEYS = ("mean_cost", "transmissions", "transmission_rate", "return")

@@ -15,6 +15,7 @@ from baselines.statistics import (
     paired_ratio,
     proportion_summary,
     seeds_ratio,
+    seeds_summary,
     summarize,
 )
 from etsc_envs.protocol import (
@@ -145,6 +146,26 @@ def test_several_seeds_aggregate_with_the_stratified_bootstrap() -> None:
     assert result["runs"] == 3 and result["per_run"] == pytest.approx([0.9, 1.0, 1.1])
     assert result["range"] == pytest.approx([0.9, 1.1])
     assert result["iqm_ci95"][0] <= result["iqm"] <= result["iqm_ci95"][1]
+
+
+def test_stratified_intervals_are_the_same_in_every_call() -> None:
+    """rliable resamples from NumPy's global generator: the interval must not depend on what
+    drew from it before (a record is reproduced digit for digit), and the caller's stream is
+    left as it was."""
+    pytest.importorskip("rliable")
+    rng = np.random.default_rng(3)
+    reference = rng.uniform(1.0, 2.0, 16)
+    runs = reference * rng.uniform(0.8, 1.2, (3, 16))
+    first_ratio, first_mean = seeds_ratio(runs, reference), seeds_summary(runs)
+    np.random.seed(123)
+    expected_draw = np.random.random()
+    np.random.seed(123)
+    again_ratio, again_mean = seeds_ratio(runs, reference), seeds_summary(runs)
+    assert np.random.random() == expected_draw
+    assert again_ratio["iqm_ci95"] == first_ratio["iqm_ci95"]
+    assert again_mean["mean_ci95"] == first_mean["mean_ci95"]
+    low, high = first_mean["mean_ci95"]
+    assert low < runs.mean() < high
 
 
 def test_seeds_that_learned_one_policy_keep_the_scenarios_spread() -> None:
