@@ -86,4 +86,35 @@ def make_aec(env_id: str, **kwargs: Any) -> pettingzoo.AECEnv:
     return pettingzoo.make("aec", _require_pettingzoo_id(env_id), **kwargs)
 
 
+def load_policy(path: str, env: Any) -> Any:
+    """The trigger policy stored at ``path`` for ``env`` (a Gymnasium env of this package, or
+    a PettingZoo parallel env, whose agents then share the policy), answering
+    ``predict(obs, state=None, episode_start=None, deterministic=True)`` like an SB3 model.
+
+    Reads a learned trigger (``learned.json`` of ``python -m agents.search``, or a ``learned:``
+    prefix before its path): :class:`~etsc_envs.triggers.family.LearnedTrigger`. Raises
+    ``ValueError`` naming ``path`` for anything else; SB3 zips load with the checkout's
+    ``baselines.policies.load_sb3``, which needs the ``train`` extra.
+    """
+    from etsc_envs.triggers.family import LearnedTrigger
+
+    path = str(path).removeprefix("learned:")
+    if not path.endswith(".json"):
+        raise ValueError(
+            f"path: load_policy reads learned triggers (.json), got {path!r}; SB3 zips load "
+            "with baselines.policies.load_sb3 in the checkout"
+        )
+    learned = LearnedTrigger.load(path)
+    if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
+        agent = env.possible_agents[0]
+        spaces = (env.observation_space(agent), env.action_space(agent))
+        names = tuple(env.unwrapped.agent_observation_names)
+        period = env.unwrapped.loop.sampling_period_s
+    else:
+        spaces = (env.observation_space, env.action_space)
+        names = tuple(env.unwrapped.observation_names)
+        period = env.unwrapped.sampling_period_s
+    return learned.trigger(*spaces, names, period)
+
+
 __version__ = "0.1.0"

@@ -249,3 +249,28 @@ def test_factors_outside_the_papers_bounds_are_refused() -> None:
         scaled_thresholds(OrbitAttitudeTrigger, {"a1": 6.0})
     with pytest.raises(ValueError, match="allowed"):
         scaled_thresholds(AttitudeTrackingTrigger, {"pi": 2.0})
+
+
+def test_load_policy_runs_a_learned_file_from_the_package(tmp_path) -> None:
+    """``etsc_envs.load_policy`` (the installed package's loader) gives the family's trigger,
+    the same decisions as building it directly; other files are refused naming the path."""
+    import etsc_envs
+
+    env = gym.make("etsc/AttitudeTracking-v0", horizon_s=1.0)
+    point = FamilyPoint(factors={"psi": 4.0}, heartbeat_instants=100, first_instant=True)
+    path = tmp_path / "learned.json"
+    LearnedTrigger("etsc/AttitudeTracking-v0", "AttitudeTrackingTrigger", point).save(path)
+    policy = etsc_envs.load_policy(str(path), env)
+    direct = _family("etsc/AttitudeTracking-v0", point)(
+        env.observation_space,
+        env.action_space,
+        env.unwrapped.observation_names,
+        env.unwrapped.sampling_period_s,
+    )
+    obs, _ = env.reset(seed=3)
+    for _ in range(300):
+        action, _ = policy.predict(obs)
+        assert action == direct.predict(obs)[0]
+        obs, *_ = env.step(action)
+    with pytest.raises(ValueError, match="path"):
+        etsc_envs.load_policy(str(tmp_path / "model.zip"), env)
