@@ -8,7 +8,6 @@ native vector env (:func:`baselines.batch.run_batch`), and the best-scoring mode
 from __future__ import annotations
 
 import json
-import pickle
 import time
 from pathlib import Path
 from typing import Any
@@ -21,7 +20,7 @@ from agents.model_files import write_model
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
-from baselines.policies import NormalizedModel
+from baselines.policies import NormalizedModel, ObservationStatistics
 from baselines.self_triggered import DecisionSet, IntervalSchedule, SelfTriggeredPolicy
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.protocol import scenario_set
@@ -183,7 +182,7 @@ class PaperComparisonCallback(BaseCallback):
         model = (
             self.model
             if normalization is None
-            else NormalizedModel(self.model, pickle.loads(pickle.dumps(normalization)))
+            else NormalizedModel(self.model, ObservationStatistics.of(normalization))
         )
         if self._deployment is None:
             return model

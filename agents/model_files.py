@@ -11,12 +11,11 @@ instead of the interrupt the command line turns into "continue with --resume".
 from __future__ import annotations
 
 import io
-import pickle
 from pathlib import Path
 
 from stable_baselines3.common.base_class import BaseAlgorithm
 
-from baselines.policies import normalization_path
+from baselines.policies import ObservationStatistics, normalization_path
 from baselines.self_triggered import DecisionSet
 from etsc_envs.core.files import atomic_write_bytes, interrupts_deferred
 
@@ -27,16 +26,16 @@ def write_model(
     decisions: DecisionSet | None = None,
     statistics_path: Path | None = None,
 ) -> None:
-    """Write ``model`` at ``path``, its ``VecNormalize`` statistics (if it has any) at
-    ``statistics_path`` (default: :func:`~baselines.policies.normalization_path`) and its
-    decision set (if any) beside it."""
+    """Write ``model`` at ``path``, its ``VecNormalize`` statistics (if it has any, as
+    :class:`~baselines.policies.ObservationStatistics` data) at ``statistics_path`` (default:
+    :func:`~baselines.policies.normalization_path`) and its decision set (if any) beside it."""
     with interrupts_deferred():
         if decisions is not None:
             decisions.save(path)
         statistics = model.get_vec_normalize_env()
         if statistics is not None:
             statistics_path = statistics_path or normalization_path(path)
-            atomic_write_bytes(statistics_path, pickle.dumps(statistics))
+            atomic_write_bytes(statistics_path, ObservationStatistics.of(statistics).to_bytes())
         buffer = io.BytesIO()
         model.save(buffer)
         atomic_write_bytes(path, buffer.getvalue())

@@ -289,6 +289,14 @@ def main(argv: list[str] | None = None) -> int:
             trials = run_sweep_in_processes(sweep, args.processes, args.resume, _description(sweep))
     except (OSError, ValueError, yaml.YAMLError) as error:
         parser.error(str(error))
+    except KeyboardInterrupt:
+        processes = "" if args.processes is None else f" --processes {args.processes}"
+        print(
+            f"\ninterrupted; finished trials are kept, continue the sweep with: python -m "
+            f"agents.sweep --config {args.config}{processes} --resume",
+            file=sys.stderr,
+        )
+        return 130
     return _report(sweep, trials)
 
 

@@ -16,6 +16,8 @@ in its OpenMP pool (the reason :mod:`baselines.batch` spawns too).
 from __future__ import annotations
 
 import multiprocessing
+import os
+import signal
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -49,6 +51,9 @@ def check_process_sweep(sweep: SweepConfig, processes: int) -> None:
 def _run_trial(sweep: SweepConfig, values: dict[str, Any], folder: Path) -> str | None:
     """Train one trial into ``folder`` (continuing from its newest checkpoint if it has one);
     ``None`` on success, else the error as ``Type: first line``."""
+    if _STOP is not None and _STOP.is_set():
+        return "interrupted"
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # a running trial stops on Ctrl-C
     try:
         config = sweep.trial_config(values, folder)
         resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
@@ -57,7 +62,24 @@ def _run_trial(sweep: SweepConfig, values: dict[str, Any], folder: Path) -> str 
         train(config, resume=resume)
     except Exception as error:  # a failed trial is recorded, the others go on
         return one_line_error(error)
+    except KeyboardInterrupt:  # the sweep's runner says how to continue
+        return "interrupted"
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     return None
+
+
+_STOP: Any = None
+"""In a worker: the runner's event, set when the sweep is interrupted."""
+
+
+def _start_worker(stop: Any) -> None:
+    """A worker between trials ignores Ctrl-C (the terminal sends it to every process of the
+    sweep): the runner stops the pool, and only a running trial stops on it; once ``stop`` is
+    set, a trial still queued to the worker returns without training."""
+    global _STOP
+    _STOP = stop
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def run_sweep_in_processes(
@@ -77,12 +99,25 @@ def run_sweep_in_processes(
     errors: dict[str, str | None] = {}
     if pending:
         context = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(min(processes, len(pending)), mp_context=context) as pool:
+        stop = context.Event()
+        with ProcessPoolExecutor(
+            min(processes, len(pending)),
+            mp_context=context,
+            initializer=_start_worker,
+            initargs=(stop,),
+        ) as pool:
             futures = {
                 name: pool.submit(_run_trial, sweep, values, sweep.trial_folder(name))
                 for name, values in pending.items()
             }
-            errors = {name: future.result() for name, future in futures.items()}
+            try:
+                errors = {name: future.result() for name, future in futures.items()}
+            except KeyboardInterrupt:
+                stop.set()  # trials queued to a worker already return at once
+                pool.shutdown(wait=False, cancel_futures=True)
+                for worker in multiprocessing.active_children():  # a running trial stops
+                    os.kill(worker.pid, signal.SIGINT)
+                raise
     trials = []
     for name, values in points.items():
         folder = sweep.trial_folder(name)

@@ -6,7 +6,7 @@ Layout of a sweep's ``results_dir`` (see :mod:`agents.sweep_config`)::
     sweep_summary.json          every trial: name, swept values, status, error, final scores
     sweep_settings.json         the validated sweep config it started with (``--resume``
                                 refuses changed settings)
-    trials/<name>/              one ``agents.train`` run: model.zip, model_vecnormalize.pkl,
+    trials/<name>/              one ``agents.train`` run: model.zip, model_vecnormalize.npz,
                                 config.yaml, evaluations.json, train_summary.json, ...
     tune/                       Ray Tune's experiment state (what ``--resume`` restores)
 

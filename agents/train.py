@@ -5,7 +5,7 @@
 
 Writes to the output directory ``model.zip`` (a plain SB3 save, loadable by
 ``python -m baselines.evaluate ENV_ID --policy sb3:DIR/model.zip``) with
-``model_vecnormalize.pkl`` beside it when observations are normalised and
+``model_vecnormalize.npz`` beside it when observations are normalised and
 ``model_decisions.json`` when it takes self-triggered decisions (config key ``decisions``),
 ``config.yaml`` (the
 config after the command-line overrides and defaults), ``train_summary.json`` (wall time,
@@ -27,20 +27,22 @@ prints one line saying how to continue and exits with status 130.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import functools
 import importlib.util
 import json
-import pickle
+import shutil
 import sys
 import time
 import warnings
 import zipfile
 from collections import deque
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+import filelock
 import gymnasium as gym
 import numpy as np
 import torch
@@ -69,8 +71,13 @@ from agents.evaluation import PaperComparisonCallback
 from agents.imitation import imitate_decision, imitate_paper_trigger
 from agents.model_files import write_model
 from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
-from baselines.policies import ENV_ID_ATTRIBUTE, normalization_path
-from baselines.self_triggered import DecisionSet
+from baselines.policies import (
+    ENV_ID_ATTRIBUTE,
+    ObservationStatistics,
+    legacy_normalization_path,
+    normalization_path,
+)
+from baselines.self_triggered import DecisionSet, decision_set_path
 from etsc_envs.core.files import atomic_write_text
 
 MODEL_FILE = "model.zip"
@@ -83,6 +90,9 @@ BEST_MODEL_FILE = "best_model.zip"
 choice follows the test protocol), its observation statistics beside it."""
 CHECKPOINT_DIR = "checkpoints"
 CHECKPOINT_PREFIX = "model"
+LOCK_FILE = ".train.lock"
+"""In ``out_dir``: the file a run holds an OS lock on while it trains there (the file stays;
+the lock ends with the run or its process)."""
 RUN_FILE = "run.yaml"
 """In ``checkpoints/``: the config of the run that writes the checkpoints there."""
 TENSORBOARD_DIR = "tensorboard"
@@ -136,25 +146,101 @@ def _plain(value: Any) -> Any:
 
 
 def train(
-    config: TrainConfig, resume: bool = False, callbacks: Sequence[BaseCallback] = ()
+    config: TrainConfig,
+    resume: bool = False,
+    callbacks: Sequence[BaseCallback] = (),
+    overwrite: bool = False,
 ) -> Path:
     """Train the configured model (from the newest intact checkpoint if ``resume``), write the
     output files and return the output folder. ``callbacks`` run after the run's own (episode
     metrics, checkpoints, evaluations), e.g. to report progress to a tuner. A bad env kwarg,
     hyperparameter, ``init_from`` or checkpoint raises ``ValueError`` before ``out_dir`` is
-    created."""
+    created.
+
+    ``out_dir`` belongs to one run: a fresh run refuses a folder holding another run's model,
+    summary or checkpoints unless ``overwrite`` (which removes that run's files first), and a
+    lock file (:data:`LOCK_FILE`, held for the whole run) refuses a second process training
+    into the same folder."""
     torch.set_num_threads(config.torch_threads)
     out_dir = Path(config.out_dir)
-    checkpoint = resume_checkpoint(config) if resume else None
-    if not resume:
-        _refuse_foreign_checkpoints(config)
     created = not out_dir.exists()
+    out_dir.mkdir(parents=True, exist_ok=True)
     try:
-        return _train(config, out_dir, checkpoint, callbacks)
+        with _run_lock(out_dir):
+            checkpoint = resume_checkpoint(config) if resume else None
+            if not resume:
+                _clear_earlier_run(out_dir, overwrite)
+            return _train(config, out_dir, checkpoint, callbacks)
     except BaseException:
         if created:
-            _remove_empty_folders(out_dir)
+            _remove_empty_folders(out_dir, ignored=LOCK_FILE)
         raise
+
+
+@contextlib.contextmanager
+def _run_lock(out_dir: Path) -> Iterator[None]:
+    """Hold ``out_dir``'s :data:`LOCK_FILE` for the block, or ``ValueError`` when another
+    process holds it (the ``filelock`` package: an OS lock, released when the process ends)."""
+    lock = filelock.FileLock(out_dir / LOCK_FILE, timeout=0)
+    try:
+        lock.acquire()
+    except filelock.Timeout:
+        raise ValueError(
+            f"out_dir {str(out_dir)!r} is in use by another agents.train run (it holds "
+            f"{LOCK_FILE}); wait for it to end or train into another out_dir"
+        ) from None
+    try:
+        yield
+    finally:
+        lock.release()
+
+
+def _earlier_run_files(out_dir: Path) -> list[Path]:
+    """The files and folders of a run in ``out_dir`` (its model with the files beside it,
+    config, summary, evaluations, checkpoints, TensorBoard logs)."""
+    models = [out_dir / MODEL_FILE, out_dir / BEST_MODEL_FILE]
+    beside = [
+        path
+        for model in models
+        for path in (
+            normalization_path(model),
+            legacy_normalization_path(model),
+            decision_set_path(model),
+        )
+    ]
+    named = [
+        out_dir / name
+        for name in (
+            CONFIG_FILE,
+            SUMMARY_FILE,
+            EVALUATIONS_FILE,
+            SELECTION_FILE,
+            CHECKPOINT_DIR,
+            TENSORBOARD_DIR,
+        )
+    ]
+    return [path for path in (*models, *beside, *named) if path.exists()]
+
+
+def _clear_earlier_run(out_dir: Path, overwrite: bool) -> None:
+    """Before a fresh run: ``ValueError`` if ``out_dir`` holds a finished run's model or
+    summary, or an earlier run's checkpoints (a later resume would take the highest step
+    count, whichever run wrote it), unless ``overwrite``, which removes that run's files."""
+    earlier = [out_dir / MODEL_FILE, out_dir / SUMMARY_FILE]
+    newest = latest_checkpoint(out_dir / CHECKPOINT_DIR)
+    found = [path for path in earlier if path.is_file()] + ([newest] if newest else [])
+    if not found:
+        return
+    if not overwrite:
+        raise ValueError(
+            f"out_dir {str(out_dir)!r} holds an earlier run ({found[0]}); continue it with "
+            "--resume, replace it with --overwrite, or train into another out_dir"
+        )
+    for path in _earlier_run_files(out_dir):
+        if path.is_dir():
+            shutil.rmtree(path)
+        else:
+            path.unlink()
 
 
 def _train(
@@ -330,7 +416,7 @@ def decision_set(config: TrainConfig, env: VecEnv) -> DecisionSet | None:
 
 
 class AtomicCheckpointCallback(CheckpointCallback):
-    """SB3's checkpoints (``model_<N>_steps.zip`` with ``model_vecnormalize_<N>_steps.pkl``
+    """SB3's checkpoints (``model_<N>_steps.zip`` with ``model_vecnormalize_<N>_steps.npz``
     and, for self-triggered decisions, ``model_<N>_steps_decisions.json``), written through
     temporary files, the model last (:func:`~agents.model_files.write_model`)."""
 
@@ -344,7 +430,7 @@ class AtomicCheckpointCallback(CheckpointCallback):
                 self.model,
                 Path(self._checkpoint_path(extension="zip")),
                 self.decisions,
-                statistics_path=Path(self._checkpoint_path("vecnormalize_", extension="pkl")),
+                statistics_path=Path(self._checkpoint_path("vecnormalize_", extension="npz")),
             )
         return True
 
@@ -441,18 +527,6 @@ def _require_same_run(config: TrainConfig, folder: Path) -> None:
         )
 
 
-def _refuse_foreign_checkpoints(config: TrainConfig) -> None:
-    """A fresh run must not write its checkpoints among an earlier run's (a later resume would
-    take the highest step count, whichever run wrote it)."""
-    folder = Path(config.out_dir) / CHECKPOINT_DIR
-    newest = latest_checkpoint(folder)
-    if config.checkpoint_every and newest is not None:
-        raise ValueError(
-            f"out_dir already holds checkpoints of an earlier run ({newest}); continue it with "
-            "--resume, or train into another out_dir"
-        )
-
-
 def _checkpoint_problem(checkpoint: Path, normalized: bool) -> str | None:
     """Why ``checkpoint`` cannot be resumed from (``None`` if it can)."""
     try:
@@ -466,22 +540,25 @@ def _checkpoint_problem(checkpoint: Path, normalized: bool) -> str | None:
     if not normalized:
         return None
     statistics = _checkpoint_statistics(checkpoint)
-    try:
-        pickle.loads(statistics.read_bytes())
-    except FileNotFoundError:
+    if not statistics.is_file():
         return f"its statistics {statistics.name} are missing"
-    except Exception as error:
-        return f"its statistics {statistics.name} are unreadable ({type(error).__name__})"
+    try:
+        ObservationStatistics.read(statistics)
+    except ValueError:
+        return f"its statistics {statistics.name} are unreadable"
     return None
 
 
-def _remove_empty_folders(folder: Path) -> None:
-    """Remove ``folder`` and its subfolders if no file is left in them."""
+def _remove_empty_folders(folder: Path, ignored: str | None = None) -> None:
+    """Remove ``folder`` and its subfolders if no file is left in them (a file named
+    ``ignored`` directly in ``folder`` does not count, and goes with it)."""
     if not folder.is_dir():
         return
     for child in folder.iterdir():
         _remove_empty_folders(child)
-    if not any(folder.iterdir()):
+    if all(child.name == ignored and child.is_file() for child in folder.iterdir()):
+        for child in folder.iterdir():
+            child.unlink()
         folder.rmdir()
 
 
@@ -584,7 +661,7 @@ def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> Ve
             clip_obs=config.observation_clip,
             gamma=config.hyperparameters.get("gamma", 0.99),
         )
-    normalized = VecNormalize.load(str(statistics), env)
+    normalized = ObservationStatistics.read(statistics).restore(env)
     normalized.training = True
     normalized.norm_obs = config.normalize_observations
     normalized.norm_reward = config.normalize_rewards
@@ -610,7 +687,7 @@ def _start_statistics(config: TrainConfig, checkpoint: Path | None) -> Path | No
 def _checkpoint_statistics(checkpoint: Path) -> Path:
     """The statistics SB3's ``CheckpointCallback`` saved with ``model_<N>_steps.zip``."""
     steps = checkpoint.stem.split("_")[-2]
-    return checkpoint.with_name(f"{CHECKPOINT_PREFIX}_vecnormalize_{steps}_steps.pkl")
+    return checkpoint.with_name(f"{CHECKPOINT_PREFIX}_vecnormalize_{steps}_steps.npz")
 
 
 def _progress_bar_available() -> bool:
@@ -655,8 +732,14 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="MODEL",
         help="override init_from (e.g. each seed's run of a curriculum's previous stage)",
     )
-    parser.add_argument(
+    runs = parser.add_mutually_exclusive_group()
+    runs.add_argument(
         "--resume", action="store_true", help="continue from the newest checkpoint of out_dir"
+    )
+    runs.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="remove the earlier run in out_dir (model, checkpoints, logs) and train afresh",
     )
     return parser
 
@@ -678,7 +761,7 @@ def main(argv: list[str] | None = None) -> int:
     except (OSError, ValueError, yaml.YAMLError) as error:
         parser.error(str(error))
     try:
-        out_dir = train(config, resume=args.resume)
+        out_dir = train(config, resume=args.resume, overwrite=args.overwrite)
     except ValueError as error:
         parser.error(str(error))
     except KeyboardInterrupt:
@@ -689,7 +772,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 130
     for path in sorted(out_dir.iterdir()):
-        print(f"wrote {path}")
+        if path.name != LOCK_FILE:
+            print(f"wrote {path}")
     return 0
 
 

@@ -100,56 +100,87 @@ def evaluate(
     edges = None if windows_s is None else window_edges(windows_s)
     setup = episode_setup(env_id, env_args)
     trigger = setup.make_policy(policy, policy_args)
-    if plot_dir is None and edges is None:
-        setup.env.close()
-        processes = process_count(len(seeds)) if processes is None else processes
-        description = f"{policy} on {len(seeds)} scenario" + ("s" if len(seeds) > 1 else "")
-        if processes > 1:
-            records = run_batch_in_processes(
-                env_id,
-                policy,
-                policy_args,
-                seeds,
-                env_args,
-                processes=processes,
-                progress=progress,
-                description=description,
-            )
+    records: list[dict[str, Any]] = []
+    try:
+        if plot_dir is None and edges is None:
+            setup.env.close()
+            processes = process_count(len(seeds)) if processes is None else processes
+            description = f"{policy} on {len(seeds)} scenario" + ("s" if len(seeds) > 1 else "")
+            if processes > 1:
+                records[:] = run_batch_in_processes(
+                    env_id,
+                    policy,
+                    policy_args,
+                    seeds,
+                    env_args,
+                    processes=processes,
+                    progress=progress,
+                    description=description,
+                )
+            else:
+                records[:] = run_batch(
+                    env_id, trigger, seeds, env_args, progress=progress, description=description
+                )
         else:
-            records = run_batch(
-                env_id, trigger, seeds, env_args, progress=progress, description=description
-            )
-    else:
-        records = []
-        for index, episode_seed in enumerate(seeds):
-            record, trace = setup.run(
-                setup.env,
-                trigger,
-                episode_seed,
-                sample_every=None,
-                progress=progress,
-                description=f"{policy} episode {index + 1}/{len(seeds)}",
-            )
-            if edges is not None:
-                record["windows"] = trace.window_totals(edges)
-            records.append(record)
-            if plot_dir is not None:
-                title = f"{env_id} - {policy} {policy_args or ''} - seed {episode_seed}"
-                plot_episode(trace, Path(plot_dir) / f"episode_{index:03d}.png", title)
+            for index, episode_seed in enumerate(seeds):
+                record, trace = setup.run(
+                    setup.env,
+                    trigger,
+                    episode_seed,
+                    sample_every=None,
+                    progress=progress,
+                    description=f"{policy} episode {index + 1}/{len(seeds)}",
+                )
+                if edges is not None:
+                    record["windows"] = trace.window_totals(edges)
+                records.append(record)
+                if plot_dir is not None:
+                    title = f"{env_id} - {policy} {policy_args or ''} - seed {episode_seed}"
+                    plot_episode(trace, Path(plot_dir) / f"episode_{index:03d}.png", title)
+            setup.env.close()
+    except KeyboardInterrupt:
         setup.env.close()
-    result = {
+        raise EvaluationInterrupted(
+            {**_result(env_id, policy, policy_args, env_args, described, records), "partial": True},
+            len(seeds),
+        ) from None
+    result = _result(env_id, policy, policy_args, env_args, described, records)
+    if edges is not None:
+        result["windows"] = _mean_windows(records)
+    return result
+
+
+class EvaluationInterrupted(KeyboardInterrupt):
+    """Ctrl-C during :func:`evaluate`: ``result`` holds the records of the episodes that
+    finished before it (``"partial": true``), ``planned`` the number of episodes asked for.
+    Episodes run together in a batch (no plots, no windows) finish together, so an interrupted
+    batch has none; episodes run one by one keep every one that ended."""
+
+    def __init__(self, result: dict[str, Any], planned: int) -> None:
+        super().__init__()
+        self.result = result
+        self.planned = planned
+
+
+def _result(
+    env_id: str,
+    policy: str,
+    policy_args: dict[str, Any],
+    env_args: dict[str, Any],
+    described: dict[str, Any] | None,
+    records: list[dict[str, Any]],
+) -> dict[str, Any]:
+    """The JSON of :func:`evaluate` for ``records`` (no means nor aggregates of no record)."""
+    return {
         "env": env_id,
         "policy": policy,
         "policy_args": policy_args,
         "env_args": env_args,
         "scenarios": described,
         "episodes": records,
-        "mean": mean_record(records),
-        "aggregates": aggregate_records(records),
+        "mean": mean_record(records) if records else {},
+        "aggregates": aggregate_records(records) if records else {},
     }
-    if edges is not None:
-        result["windows"] = _mean_windows(records)
-    return result
 
 
 def _mean_windows(records: list[dict[str, Any]]) -> list[dict[str, float]]:
@@ -231,6 +262,22 @@ def main(argv: list[str] | None = None) -> int:
         )
     except (ValueError, TypeError, gym.error.Error) as error:
         parser.error(str(error))
+    except EvaluationInterrupted as interrupted:
+        finished = len(interrupted.result["episodes"])
+        where = "not written (no --json)"
+        if args.json:
+            write_json(interrupted.result, args.json)
+            output = "standard output" if args.json == "-" else args.json
+            where = f"written to {output}, marked partial"
+        print(
+            f"interrupted: {finished} of {interrupted.planned} episode(s) finished, their "
+            f"records {where}",
+            file=sys.stderr,
+        )
+        return 130
+    except KeyboardInterrupt:
+        print("interrupted before any episode ran; nothing written", file=sys.stderr)
+        return 130
     if args.json:
         write_json(result, args.json)
     summary = sys.stderr if args.json == "-" else sys.stdout

@@ -9,9 +9,10 @@ deterministic=True) -> (action, state)``.
 from __future__ import annotations
 
 import inspect
-import pickle
-import warnings
+import io
+import json
 import zipfile
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
@@ -29,30 +30,118 @@ def _one_line(error: BaseException) -> str:
 
 
 def read_model_record(path: str | Path) -> dict[str, Any]:
-    """The ``data`` record of a Stable-Baselines3 zip (spaces unpickled), or ``ValueError``
-    naming the file if it is missing, not a zip, or not an SB3 save."""
-    from stable_baselines3.common.save_util import json_to_data
+    """The ``data`` record of a Stable-Baselines3 zip read as JSON, without unpickling any of
+    its entries, or ``ValueError`` naming the file if it is missing, not a zip, or not an SB3
+    save.
 
+    SB3 stores the objects it cannot write as JSON (the policy class, the spaces, schedules,
+    training buffers) as cloudpickle blobs inside the record, each beside the plain values of
+    its attributes. The record returned keeps the plain values, with ``policy_module`` (the
+    policy class's module), ``observation_space`` and ``action_space`` rebuilt from those
+    attributes (:func:`_space_from_record`; a ``Box`` with unbounded limits: a policy reads
+    only its shape and dtype), and ``serialized`` (the names of the pickled entries)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"sb3 model file not found: {path}")
     try:
-        with zipfile.ZipFile(path) as archive, warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # an unreadable entry is reported below instead
-            record = json_to_data(archive.read("data").decode("utf-8"))
+        with zipfile.ZipFile(path) as archive:
+            stored = json.loads(archive.read("data").decode("utf-8"))
+        if not isinstance(stored, dict):
+            raise ValueError("its data record is not a JSON object")
+        serialized = {
+            key for key, value in stored.items() if isinstance(value, dict) and SERIALIZED in value
+        }
+        record = {key: value for key, value in stored.items() if key not in serialized}
+        record["serialized"] = serialized
+        record["policy_module"] = stored["policy_class"]["__module__"]
+        for key in ("observation_space", "action_space"):
+            record[key] = _space_from_record(stored[key])
     except Exception as error:  # whatever a damaged or foreign file makes the readers raise
         raise ValueError(
             f"{path} is not a readable Stable-Baselines3 model ({_one_line(error)})"
         ) from None
-    expected = {"policy_class": type, "observation_space": gym.Space, "action_space": gym.Space}
-    missing = [
-        key
-        for key, kind in expected.items()
-        if not isinstance(record, dict) or not isinstance(record.get(key), kind)
-    ]
-    if missing:
-        raise ValueError(f"{path} is not a readable Stable-Baselines3 model (no valid {missing})")
     return record
+
+
+SERIALIZED = ":serialized:"
+"""The key under which SB3's ``data`` record holds a cloudpickled object."""
+
+
+def _space_from_record(entry: dict[str, Any]) -> gym.Space:
+    """The space a cloudpickled entry of SB3's record describes, rebuilt from the plain
+    attributes stored beside the pickle (``ValueError`` for another kind of space)."""
+    kind = entry[":type:"]
+    shape = tuple(int(size) for size in entry["_shape"])
+    if kind == "<class 'gymnasium.spaces.box.Box'>":
+        dtype = np.dtype(entry["dtype"])
+        if dtype.kind != "f":
+            raise ValueError(f"a Box of dtype {dtype} (the suite loads float Boxes)")
+        return gym.spaces.Box(-np.inf, np.inf, shape, dtype)
+    if kind == "<class 'gymnasium.spaces.discrete.Discrete'>":
+        return gym.spaces.Discrete(int(entry["n"]), start=int(entry["start"]))
+    if kind == "<class 'gymnasium.spaces.multi_binary.MultiBinary'>":
+        return gym.spaces.MultiBinary(list(shape) if len(shape) > 1 else shape[0])
+    if kind == "<class 'gymnasium.spaces.multi_discrete.MultiDiscrete'>":
+        counts = [int(word) for word in str(entry["nvec"]).strip("[]").split()]
+        return gym.spaces.MultiDiscrete(np.reshape(counts, shape), dtype=entry["dtype"])
+    raise ValueError(
+        f"a space of {kind} (the suite loads Box, Discrete, MultiBinary, MultiDiscrete)"
+    )
+
+
+ACTING_PLACEHOLDERS: dict[str, Any] = {
+    "_last_obs": None,
+    "_last_episode_starts": None,
+    "_last_original_obs": None,
+    "ep_info_buffer": None,
+    "ep_success_buffer": None,
+    "rollout_buffer_class": None,
+    "replay_buffer_class": None,
+    "lr_schedule": None,
+    "exploration_schedule": None,
+    "clip_range": 0.2,
+    "train_freq": 1,
+}
+"""Pickled entries of SB3's record that hold training state only, and what a model loaded to
+act (:func:`load_sb3`) gets in their place: the constructor's defaults, rebuilt by
+``_setup_model`` where it needs them (a model loaded so is for acting, not for training on)."""
+
+
+def safe_load_objects(
+    path: str | Path,
+    record: dict[str, Any],
+    algorithm: type,
+    observation_space: gym.Space | None = None,
+    action_space: gym.Space | None = None,
+) -> dict[str, Any]:
+    """SB3's ``custom_objects`` for loading ``path`` to act without unpickling anything: every
+    cloudpickled entry of its ``record`` (:func:`read_model_record`) replaced, the policy class
+    by ``algorithm``'s ``MlpPolicy`` (of the module the record names), the spaces by the env's
+    (or the record's rebuilt ones), training state by :data:`ACTING_PLACEHOLDERS`. Another
+    pickled entry (a custom class, a schedule function, ``policy_kwargs`` holding classes) is
+    refused with one ``ValueError`` line: loading it would run what the file carries."""
+    policy_class = getattr(algorithm, "policy_aliases", {}).get("MlpPolicy")
+    if policy_class is None or policy_class.__module__ != record["policy_module"]:
+        raise ValueError(
+            f"{path}: its policy class (module {record['policy_module']}) is not "
+            f"{algorithm.__name__}'s MlpPolicy, the only policy the suite loads without "
+            "unpickling it"
+        )
+    objects: dict[str, Any] = {
+        "policy_class": policy_class,
+        "observation_space": observation_space or record["observation_space"],
+        "action_space": action_space or record["action_space"],
+    }
+    others = sorted(record["serialized"] - set(objects) - set(ACTING_PLACEHOLDERS))
+    if others:
+        raise ValueError(
+            f"{path}: its data record holds pickled {others}, which the suite does not load "
+            "(unpickling runs whatever code the file carries; see docs/security.md)"
+        )
+    objects.update(
+        {key: value for key, value in ACTING_PLACEHOLDERS.items() if key in record["serialized"]}
+    )
+    return objects
 
 
 MASKABLE_POLICY_MODULE = "sb3_contrib.common.maskable.policies"
@@ -69,8 +158,7 @@ def infer_sb3_algorithm(path: str | Path) -> type:
     import stable_baselines3 as sb3
 
     data = read_model_record(path)
-    policy_class = data["policy_class"]
-    module = getattr(policy_class, "__module__", "")
+    module = data["policy_module"]
     if module == MASKABLE_POLICY_MODULE:
         from sb3_contrib import MaskablePPO
 
@@ -155,9 +243,14 @@ def _ids_fitting(observation_space: gym.Space, action_space: gym.Space) -> str:
     return f"an env id it does not record (its spaces are those of {' and '.join(fitting)})"
 
 
-NORMALIZATION_SUFFIX = "_vecnormalize.pkl"
+NORMALIZATION_SUFFIX = "_vecnormalize.npz"
 """A model ``NAME.zip`` trained on normalised observations keeps the statistics beside it, in
-``NAME_vecnormalize.pkl`` (Stable-Baselines3's pickled ``VecNormalize``)."""
+``NAME_vecnormalize.npz`` (:class:`ObservationStatistics`: arrays only, read with
+``allow_pickle=False``)."""
+LEGACY_NORMALIZATION_SUFFIX = "_vecnormalize.pkl"
+"""Where earlier versions kept the statistics: SB3's pickled ``VecNormalize``, which is never
+unpickled here (``python -m agents.convert_statistics`` converts one after checking that it
+holds nothing else)."""
 
 
 def normalization_path(model_path: str | Path) -> Path:
@@ -166,13 +259,159 @@ def normalization_path(model_path: str | Path) -> Path:
     return model_path.with_name(model_path.stem + NORMALIZATION_SUFFIX)
 
 
+def legacy_normalization_path(model_path: str | Path) -> Path:
+    """Where earlier versions kept the statistics of ``model_path`` (a pickle)."""
+    model_path = Path(model_path)
+    return model_path.with_name(model_path.stem + LEGACY_NORMALIZATION_SUFFIX)
+
+
+@dataclass
+class ObservationStatistics:
+    """SB3 ``VecNormalize``'s running statistics as data: the observations' and the
+    discounted returns' mean, variance and count (``RunningMeanStd``), and its settings.
+
+    :meth:`normalize_obs` is ``VecNormalize.normalize_obs``: ``clip((o - mean) / sqrt(var +
+    epsilon), -clip_obs, clip_obs)`` as float32 when ``norm_obs``."""
+
+    observation_mean: np.ndarray
+    observation_var: np.ndarray
+    observation_count: float
+    return_mean: float
+    return_var: float
+    return_count: float
+    clip_obs: float
+    clip_reward: float
+    gamma: float
+    epsilon: float
+    norm_obs: bool
+    norm_reward: bool
+
+    SCALARS = (
+        "observation_count",
+        "return_mean",
+        "return_var",
+        "return_count",
+        "clip_obs",
+        "clip_reward",
+        "gamma",
+        "epsilon",
+    )
+
+    @classmethod
+    def of(cls, normalization: Any) -> ObservationStatistics:
+        """The statistics of a live ``VecNormalize`` (observations of a ``Box`` space)."""
+        if isinstance(normalization.obs_rms, dict):
+            raise ValueError("observation statistics of a Dict space are not supported")
+        return cls(
+            observation_mean=np.array(normalization.obs_rms.mean, dtype=np.float64),
+            observation_var=np.array(normalization.obs_rms.var, dtype=np.float64),
+            observation_count=float(normalization.obs_rms.count),
+            return_mean=float(normalization.ret_rms.mean),
+            return_var=float(normalization.ret_rms.var),
+            return_count=float(normalization.ret_rms.count),
+            clip_obs=float(normalization.clip_obs),
+            clip_reward=float(normalization.clip_reward),
+            gamma=float(normalization.gamma),
+            epsilon=float(normalization.epsilon),
+            norm_obs=bool(normalization.norm_obs),
+            norm_reward=bool(normalization.norm_reward),
+        )
+
+    def to_bytes(self) -> bytes:
+        """The statistics as an ``.npz`` archive of plain arrays."""
+        buffer = io.BytesIO()
+        np.savez(
+            buffer, **{field.name: np.asarray(getattr(self, field.name)) for field in fields(self)}
+        )
+        return buffer.getvalue()
+
+    @classmethod
+    def read(cls, path: str | Path) -> ObservationStatistics:
+        """The statistics saved at ``path`` (``allow_pickle=False``), or ``ValueError`` naming
+        the file when it is not exactly these arrays, finite, with variances >= 0."""
+        names = [field.name for field in fields(cls)]
+        try:
+            with np.load(path, allow_pickle=False) as archive:
+                arrays = {name: archive[name] for name in archive.files}
+        except Exception as error:  # a damaged or foreign file
+            raise ValueError(
+                f"observation statistics {path} are not a readable .npz ({_one_line(error)})"
+            ) from None
+        problem = None
+        if sorted(arrays) != sorted(names):
+            problem = f"arrays {sorted(arrays)}, expected {sorted(names)}"
+        else:
+            mean, var = arrays["observation_mean"], arrays["observation_var"]
+            numbers = [arrays[name] for name in names if name not in ("norm_obs", "norm_reward")]
+            if mean.ndim != 1 or var.shape != mean.shape:
+                problem = f"observation mean {mean.shape} and variance {var.shape}"
+            elif any(
+                arrays[name].shape != () for name in (*cls.SCALARS, "norm_obs", "norm_reward")
+            ):
+                problem = "a setting that is not a single value"
+            elif any(
+                array.dtype.kind != "f" or not np.all(np.isfinite(array)) for array in numbers
+            ):
+                problem = "a value that is not a finite float"
+            elif np.any(var < 0) or arrays["return_var"] < 0:
+                problem = "a negative variance"
+            elif any(arrays[name].dtype != np.bool_ for name in ("norm_obs", "norm_reward")):
+                problem = "norm_obs or norm_reward not a boolean"
+        if problem is not None:
+            raise ValueError(
+                f"observation statistics {path} are not VecNormalize statistics ({problem})"
+            )
+        return cls(
+            observation_mean=arrays["observation_mean"].astype(np.float64),
+            observation_var=arrays["observation_var"].astype(np.float64),
+            norm_obs=bool(arrays["norm_obs"]),
+            norm_reward=bool(arrays["norm_reward"]),
+            **{name: float(arrays[name]) for name in cls.SCALARS},
+        )
+
+    def normalize_obs(self, observation: np.ndarray) -> np.ndarray:
+        """``VecNormalize.normalize_obs`` with these statistics."""
+        if not self.norm_obs:
+            return observation
+        normalized = (observation - self.observation_mean) / np.sqrt(
+            self.observation_var + self.epsilon
+        )
+        return np.clip(normalized, -self.clip_obs, self.clip_obs).astype(np.float32)
+
+    def restore(self, venv: Any) -> Any:
+        """A ``VecNormalize`` around ``venv`` holding these statistics (to train on)."""
+        from stable_baselines3.common.vec_env import VecNormalize
+
+        normalization = VecNormalize(
+            venv,
+            norm_obs=self.norm_obs,
+            norm_reward=self.norm_reward,
+            clip_obs=self.clip_obs,
+            clip_reward=self.clip_reward,
+            gamma=self.gamma,
+            epsilon=self.epsilon,
+        )
+        if normalization.obs_rms.mean.shape != self.observation_mean.shape:
+            raise ValueError(
+                f"observation statistics of shape {self.observation_mean.shape} cannot "
+                f"normalise observations of shape {normalization.obs_rms.mean.shape}"
+            )
+        normalization.obs_rms.mean = self.observation_mean.copy()
+        normalization.obs_rms.var = self.observation_var.copy()
+        normalization.obs_rms.count = self.observation_count
+        normalization.ret_rms.mean = np.float64(self.return_mean)
+        normalization.ret_rms.var = np.float64(self.return_var)
+        normalization.ret_rms.count = self.return_count
+        return normalization
+
+
 class NormalizedModel:
     """A Stable-Baselines3 model that reads observations through ``VecNormalize`` statistics
     (``predict`` never updates them).
 
     Args:
         model: the loaded model.
-        normalization: the unpickled ``VecNormalize`` (its ``venv`` may be unset).
+        normalization: :class:`ObservationStatistics`, or a live ``VecNormalize``.
         freeze: switch the statistics' own updates off (``training = False``), as evaluation
             wants; ``False`` reads the live statistics of a run still training, which its
             training env goes on updating.
@@ -226,27 +465,41 @@ def load_sb3(
     observation statistics saved beside it if there are any (see :func:`normalization_path`).
 
     Given the spaces it must act in, first checks that the model fits them
-    (:func:`require_model_fits`). A damaged or foreign model or statistics file raises one
-    ``ValueError`` line naming it.
+    (:func:`require_model_fits`). Nothing the files carry is unpickled: the zip is loaded with
+    :func:`safe_load_objects` as SB3's ``custom_objects`` (its tensors SB3 reads with
+    ``torch.load(weights_only=True)``), the statistics are :class:`ObservationStatistics`,
+    and a legacy pickled statistics file is refused. The model returned is for acting (its
+    training state is the constructor's). A damaged or foreign model or statistics file, or
+    statistics of another env's observations, raises one ``ValueError`` line naming it.
     """
     if observation_space is not None and action_space is not None:
         require_model_fits(path, observation_space, action_space, env_id)
+    record = read_model_record(path)
     algorithm = infer_sb3_algorithm(path)
+    objects = safe_load_objects(path, record, algorithm, observation_space, action_space)
+    statistics = normalization_path(path)
+    legacy = legacy_normalization_path(path)
+    if not statistics.is_file() and legacy.is_file():
+        raise ValueError(
+            f"observation statistics {legacy} (beside the model) are a pickle, which is not "
+            f"loaded (it could run code); convert them once with: python -m "
+            f"agents.convert_statistics {legacy}"
+        )
+    normalization = ObservationStatistics.read(statistics) if statistics.is_file() else None
+    if normalization is not None and normalization.observation_mean.shape != tuple(
+        objects["observation_space"].shape
+    ):
+        raise ValueError(
+            f"observation statistics {statistics} (beside the model) are of observations of "
+            f"shape {normalization.observation_mean.shape}, the model's are "
+            f"{tuple(objects['observation_space'].shape)}: statistics of another env"
+        )
     try:
-        model = algorithm.load(path, env=env, device="cpu")
-    except Exception as error:  # whatever a damaged file makes SB3, torch or pickle raise
+        model = algorithm.load(path, env=env, device="cpu", custom_objects=objects)
+    except Exception as error:  # whatever a damaged file makes SB3 or torch raise
         raise ValueError(
             f"{path} is not a readable Stable-Baselines3 model ({_one_line(error)})"
         ) from None
-    statistics = normalization_path(path)
-    if not statistics.is_file():
+    if normalization is None:
         return model
-    try:
-        normalization = pickle.loads(statistics.read_bytes())
-        normalization.normalize_obs  # noqa: B018 - what NormalizedModel needs of it
-    except Exception as error:  # whatever a damaged or foreign pickle raises
-        raise ValueError(
-            f"observation statistics {statistics} (beside the model) are not a readable "
-            f"VecNormalize ({_one_line(error)})"
-        ) from None
     return NormalizedModel(model, normalization)

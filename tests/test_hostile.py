@@ -330,7 +330,7 @@ def _broken_model(tmp_path: Path, how: str) -> Path:
             archive.writestr("policy.pth", b"")
     elif how == "garbage statistics":
         target.write_bytes(source.read_bytes())
-        (tmp_path / "model_vecnormalize.pkl").write_bytes(b"\x80\x04garbage")
+        (tmp_path / "model_vecnormalize.npz").write_bytes(b"PK\x03\x04garbage")
     return target
 
 
@@ -524,7 +524,7 @@ def test_resume_falls_back_past_a_torn_checkpoint(tmp_path: Path, capsys, damage
         newest = checkpoints / "model_192_steps.zip"
         newest.write_bytes(newest.read_bytes()[:1000])
     else:
-        (checkpoints / "model_vecnormalize_192_steps.pkl").unlink()
+        (checkpoints / "model_vecnormalize_192_steps.npz").unlink()
     assert train_main(tmp_path, config, "--timesteps", "256", "--resume") == 0
     assert "skipping model_192_steps.zip" in capsys.readouterr().err
     summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
@@ -760,3 +760,265 @@ def test_reproduce_checks_its_outputs_before_running(tmp_path, capsys, option, w
         main(["--paper", "002", option, value])
     assert exit_info.value.code == 2
     assert option in _error_line(capsys)
+
+
+# ----------------------------------------------------------------------- model files carry data
+class _Planted:
+    """Unpickling this creates the file named by ``marker`` (what a crafted file could do)."""
+
+    def __init__(self, marker: str) -> None:
+        self.marker = marker
+
+    def __reduce__(self):
+        return (Path.touch, (Path(self.marker),))
+
+
+def _copy_model(tmp_path: Path, name: str = "AttitudeTracking-v0_ppo") -> Path:
+    target = tmp_path / "model.zip"
+    target.write_bytes((MODELS / f"{name}.zip").read_bytes())
+    statistics = MODELS / f"{name}_vecnormalize.npz"
+    (tmp_path / "model_vecnormalize.npz").write_bytes(statistics.read_bytes())
+    return target
+
+
+def test_a_pickle_planted_beside_a_model_is_not_run(tmp_path: Path, capsys) -> None:
+    from baselines.evaluate import main
+
+    model = _copy_model(tmp_path)
+    marker = tmp_path / "ran"
+    (tmp_path / "model_vecnormalize.npz").unlink()
+    (tmp_path / "model_vecnormalize.pkl").write_bytes(pickle.dumps(_Planted(str(marker))))
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--policy", f"sb3:{model}", "--env-arg=horizon_s=0.05"])
+    assert exit_info.value.code == 2
+    line = _error_line(capsys)
+    assert "model_vecnormalize.pkl" in line and "agents.convert_statistics" in line, line
+    assert not marker.exists()
+
+
+def test_a_pickle_planted_as_npz_statistics_is_not_run(tmp_path: Path, capsys) -> None:
+    from baselines.evaluate import main
+
+    model = _copy_model(tmp_path)
+    marker = tmp_path / "ran"
+    np.savez(
+        tmp_path / "model_vecnormalize.npz",
+        observation_mean=np.array([_Planted(str(marker))], dtype=object),
+    )
+    with pytest.raises(SystemExit):
+        main(["etsc/AttitudeTracking-v0", "--policy", f"sb3:{model}", "--env-arg=horizon_s=0.05"])
+    assert "model_vecnormalize.npz" in _error_line(capsys)
+    assert not marker.exists()
+
+
+def test_the_converter_refuses_a_planted_pickle_without_running_it(tmp_path: Path, capsys):
+    from agents.convert_statistics import main
+
+    marker = tmp_path / "ran"
+    planted = tmp_path / "model_vecnormalize.pkl"
+    planted.write_bytes(pickle.dumps(_Planted(str(marker))))
+    assert main([str(planted)]) == 1
+    err = capsys.readouterr().err
+    assert "is not a pickled VecNormalize" in err and "pathlib" in err, err
+    assert not marker.exists() and planted.exists()
+
+
+def test_a_pickle_planted_in_a_models_data_record_is_not_run(tmp_path: Path, capsys) -> None:
+    """SB3 keeps the objects it cannot write as JSON as cloudpickle blobs in the zip's
+    ``data`` record; the loader reads the record as JSON and unpickles none of them."""
+    import base64
+    import json
+
+    from baselines.evaluate import main
+
+    source = _copy_model(tmp_path)
+    marker = tmp_path / "ran"
+    blob = base64.b64encode(pickle.dumps(_Planted(str(marker)))).decode()
+    model = tmp_path / "planted.zip"
+    with zipfile.ZipFile(source) as original, zipfile.ZipFile(model, "w") as planted:
+        for item in original.infolist():
+            data = original.read(item.filename)
+            if item.filename == "data":
+                record = json.loads(data)
+                for key in ("observation_space", "clip_range", "lr_schedule", "_last_obs"):
+                    record[key][":serialized:"] = blob
+                record["extra"] = {":type:": "<class 'x'>", ":serialized:": blob}
+                data = json.dumps(record).encode()
+            planted.writestr(item, data)
+    (tmp_path / "planted_vecnormalize.npz").write_bytes(
+        (tmp_path / "model_vecnormalize.npz").read_bytes()
+    )
+    with pytest.raises(SystemExit):
+        main(["etsc/AttitudeTracking-v0", "--policy", f"sb3:{model}", "--env-arg=horizon_s=0.05"])
+    line = _error_line(capsys)
+    assert "planted.zip" in line and "pickled ['extra']" in line, line
+    assert not marker.exists()
+    # without the unknown entry the model loads, and still nothing ran
+    from baselines.policies import load_sb3
+
+    with zipfile.ZipFile(model) as archive:
+        record = json.loads(archive.read("data"))
+    del record["extra"]
+    again = tmp_path / "again.zip"
+    with zipfile.ZipFile(model) as original, zipfile.ZipFile(again, "w") as copy:
+        for item in original.infolist():
+            data = original.read(item.filename)
+            copy.writestr(item, json.dumps(record).encode() if item.filename == "data" else data)
+    env = gym.make("etsc/AttitudeTracking-v0")
+    load_sb3(again, observation_space=env.observation_space, action_space=env.action_space)
+    assert not marker.exists()
+
+
+def test_statistics_of_another_env_beside_a_model_are_named(tmp_path: Path, capsys) -> None:
+    from baselines.evaluate import main
+
+    model = _copy_model(tmp_path)
+    (tmp_path / "model_vecnormalize.npz").write_bytes(
+        (MODELS / "InnerFormation-v0_ppo_vecnormalize.npz").read_bytes()
+    )
+    with pytest.raises(SystemExit):
+        main(["etsc/AttitudeTracking-v0", "--policy", f"sb3:{model}", "--env-arg=horizon_s=0.05"])
+    line = _error_line(capsys)
+    assert "model_vecnormalize.npz" in line and "(18,)" in line and "(14,)" in line, line
+
+
+def test_the_converter_keeps_the_statistics_exactly(tmp_path: Path) -> None:
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    from agents.convert_statistics import convert
+    from baselines.policies import ObservationStatistics
+
+    env_id = GYM_IDS[0]
+    live = VecNormalize(DummyVecEnv([lambda: gym.make(env_id, **SHORT[env_id])]))
+    live.reset()
+    for _ in range(20):
+        live.step(np.zeros((1, *live.action_space.shape), dtype=live.action_space.dtype))
+    live.training = False
+    legacy = tmp_path / "model_vecnormalize.pkl"
+    legacy.write_bytes(pickle.dumps(live))
+    converted = ObservationStatistics.read(convert(legacy))
+    assert not legacy.exists()
+    observations = np.random.default_rng(0).normal(size=(8, *live.observation_space.shape))
+    observations = observations.astype(np.float32)
+    assert np.array_equal(converted.normalize_obs(observations), live.normalize_obs(observations))
+
+
+def test_shipped_models_carry_no_pickled_statistics() -> None:
+    assert not list(MODELS.glob("*.pkl"))
+    for statistics in MODELS.glob("*_vecnormalize.npz"):
+        with np.load(statistics, allow_pickle=False) as archive:
+            assert all(archive[name].dtype != object for name in archive.files)
+
+
+# ----------------------------------------------------------------------- run folders
+def test_a_finished_run_is_not_replaced_without_overwrite(tmp_path: Path, capsys) -> None:
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    config = tiny_training_config(out_dir, total_timesteps=64, checkpoint_every=0)
+    assert train_main(tmp_path, config) == 0
+    model = (out_dir / "model.zip").read_bytes()
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        train_main(tmp_path, config)
+    line = _error_line(capsys)
+    assert "--resume" in line and "--overwrite" in line and "model.zip" in line, line
+    assert (out_dir / "model.zip").read_bytes() == model
+    assert train_main(tmp_path, {**config, "seed": 5}, "--overwrite") == 0
+    assert (out_dir / "model.zip").read_bytes() != model
+
+
+def test_a_second_process_cannot_train_into_a_running_runs_folder(tmp_path: Path, capsys):
+    import filelock
+
+    pytest.importorskip("stable_baselines3")
+    out_dir = tmp_path / "run"
+    out_dir.mkdir()
+    # what a running agents.train holds
+    with filelock.FileLock(out_dir / ".train.lock"), pytest.raises(SystemExit):
+        train_main(tmp_path, tiny_training_config(out_dir))
+    line = _error_line(capsys)
+    assert "in use by another agents.train run" in line, line
+    assert not (out_dir / "model.zip").exists()
+
+
+# ----------------------------------------------------------------------- interrupts
+def test_an_interrupted_evaluation_writes_its_finished_episodes(tmp_path, capsys, monkeypatch):
+    """Ctrl-C during the fourth of six episodes (run one by one, as with --plot): the three
+    finished episodes' records are written, marked partial, with one line and status 130."""
+    import json
+
+    import baselines.evaluate as evaluate_module
+
+    plotted: list[Path] = []
+
+    def plot_or_interrupt(trace, path, title):
+        if len(plotted) == 3:
+            raise KeyboardInterrupt
+        plotted.append(path)
+
+    monkeypatch.setattr(evaluate_module, "plot_episode", plot_or_interrupt)
+    output = tmp_path / "partial.json"
+    status = evaluate_module.main(
+        [
+            "etsc/AttitudeTracking-v0",
+            "--policy",
+            "paper",
+            "--env-arg=horizon_s=0.05",
+            "--episodes",
+            "6",
+            "--plot",
+            str(tmp_path / "plots"),
+            "--json",
+            str(output),
+        ]
+    )
+    err = capsys.readouterr().err
+    assert status == 130
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == (
+        f"interrupted: 4 of 6 episode(s) finished, their records written to {output}, "
+        "marked partial"
+    )
+    written = json.loads(output.read_text(encoding="utf-8"))
+    assert written["partial"] is True
+    assert [record["seed"] for record in written["episodes"]] == [0, 1, 2, 3]
+
+
+def test_an_interrupted_process_sweep_says_how_to_resume(tmp_path: Path) -> None:
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import yaml
+
+    from tests.sweep_fixtures import TINY, tiny_sweep
+
+    pytest.importorskip("stable_baselines3")
+    overrides = yaml.safe_load(TINY.read_text(encoding="utf-8"))["overrides"]
+    config = tiny_sweep(tmp_path, overrides={**overrides, "total_timesteps": 10_000_000})
+    code = (
+        "import sys\n"
+        "sys.modules['ray'] = None\n"
+        "from agents.sweep import main\n"
+        f"raise SystemExit(main(['--config', {str(config)!r}, '--processes', '1']))\n"
+    )
+    log = tmp_path / "stderr.txt"
+    with open(log, "w", encoding="utf-8") as stderr_file:
+        process = subprocess.Popen(
+            [sys.executable, "-c", code],
+            cwd=Path(__file__).parents[1],
+            stdout=subprocess.DEVNULL,
+            stderr=stderr_file,
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        )
+        trials = tmp_path / "sweep" / "trials"
+        deadline = time.monotonic() + 240
+        while time.monotonic() < deadline and not list(trials.glob("*/evaluations.json")):
+            time.sleep(0.5)
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=120)
+    stderr = log.read_text(encoding="utf-8")
+    assert process.returncode == 130, stderr
+    assert "Traceback" not in stderr, stderr
+    assert "--processes 1 --resume" in stderr.strip().splitlines()[-1], stderr

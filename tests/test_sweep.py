@@ -126,7 +126,7 @@ def test_both_trials_leave_a_model_its_statistics_and_evaluations(interrupted_sw
     for name, penalty in ((FIRST, 30.0), (SECOND, 100.0)):
         folder = results_dir / by_name[name]["folder"]
         assert folder == results_dir / "trials" / name
-        for file in ("model.zip", "model_vecnormalize.pkl", "config.yaml", "train_summary.json"):
+        for file in ("model.zip", "model_vecnormalize.npz", "config.yaml", "train_summary.json"):
             assert (folder / file).stat().st_size > 0, f"{name}: {file}"
         config = yaml.safe_load((folder / "config.yaml").read_text(encoding="utf-8"))
         assert config["env_kwargs"]["transmission_penalty"] == penalty

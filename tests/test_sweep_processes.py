@@ -64,7 +64,7 @@ def test_the_grid_trains_without_ray_and_records_the_crashing_trial(process_swee
     assert "transmission_penalty must be a finite number >= 0" in crashed["error"]
     for name in FINISHING:
         folder = process_sweep["results_dir"] / "trials" / name
-        assert (folder / "model_vecnormalize.pkl").is_file()
+        assert (folder / "model_vecnormalize.npz").is_file()
         assert json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
     assert not (process_sweep["results_dir"] / "tune").exists()
 

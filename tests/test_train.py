@@ -193,11 +193,9 @@ def test_resume_continues_from_the_newest_checkpoint(tmp_path: Path) -> None:
 def test_init_from_starts_from_an_earlier_models_weights_and_statistics(
     tmp_path: Path, given_on: str
 ) -> None:
-    import pickle
-
     import numpy as np
 
-    from baselines.policies import normalization_path
+    from baselines.policies import ObservationStatistics, normalization_path
 
     first = tmp_path / "first"
     assert main(["--config", str(write_config(tiny_config(first), tmp_path))]) == 0
@@ -213,9 +211,9 @@ def test_init_from_starts_from_an_earlier_models_weights_and_statistics(
     for name, weights in before.items():
         assert np.array_equal(weights.numpy(), after[name].numpy()), name
     first_statistics, second_statistics = (
-        pickle.loads(normalization_path(run / MODEL_FILE).read_bytes()) for run in (first, second)
+        ObservationStatistics.read(normalization_path(run / MODEL_FILE)) for run in (first, second)
     )
-    assert second_statistics.obs_rms.count > first_statistics.obs_rms.count, "continued"
+    assert second_statistics.observation_count > first_statistics.observation_count, "continued"
     assert second_statistics.clip_obs == config.get("observation_clip", 10.0), "as configured"
 
 
