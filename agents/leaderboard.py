@@ -69,7 +69,7 @@ class Board:
             sweep on both sets (and the λ front drawn beside them).
         best: folder of the best hand-designed rule's ``results.json`` (its paper rule and its
             clock at the rule's rate are read there too).
-        best_label: what that rule is.
+        best_label: what that rule is, and how the judged policy holds it.
         self_triggered: folder of the self-triggered PPO run whose decisions PPO could move,
             or ``None`` where every judged self-triggered run was pinned to a rule.
         self_triggered_label: what that run is, or why there is none.
@@ -91,13 +91,16 @@ class Board:
         return self.env_id.removeprefix("etsc/")
 
 
+PINNED = "; chosen on validation, held by a pinned PPO policy (5 seeds)"
+"""How the best rule's record holds it, where PPO was pinned to it."""
+
 BOARDS = (
     Board(
         "etsc/OrbitAttitudeTracking-v0",
         "000",
         "OrbitAttitudeTracking-v0_holds_selected_front",
         "OrbitAttitudeTracking-v0_self_triggered_floor_relative_edge",
-        "eq. (21) at γ × 4 with a1, a2 = 3.1, 3.5, gating a clock of 64 instants",
+        "eq. (21) at γ × 4 with a1, a2 = 3.1, 3.5, gating a clock of 64 instants" + PINNED,
         None,
         "none judged: every self-triggered run was pinned to a rule or a clock",
         "λ front: eq. (21) at γ × 0.3 or clocks, chosen per λ on validation",
@@ -107,7 +110,7 @@ BOARDS = (
         "001",
         "ClusterContainment-v0_channel_heartbeat_selected_front",
         "ClusterContainment-v0_self_triggered",
-        "eq. (15) at c = 0.99 for every follower",
+        "eq. (15) at c = 0.99 for every follower" + PINNED,
         None,
         "none judged: every self-triggered run was pinned to a rule",
         "λ front: eq. (15) with a heartbeat per follower, chosen per λ on validation",
@@ -117,7 +120,7 @@ BOARDS = (
         "001",
         "ClusterContainmentCentral-v0_heartbeat_selected_front",
         "ClusterContainmentCentral-v0_self_triggered",
-        "eq. (15) at c = 0.99",
+        "eq. (15) at c = 0.99" + PINNED,
         None,
         "none judged: every self-triggered run was pinned to a rule",
         "λ front: eq. (15) with a heartbeat per follower, chosen per λ on validation",
@@ -127,7 +130,7 @@ BOARDS = (
         "002",
         "AttitudeTracking-v0_selected_front",
         "AttitudeTracking-v0_self_triggered",
-        "eq. (27) at 8Ψ with a heartbeat of 384 instants",
+        "eq. (27) at 8Ψ with a heartbeat of 384 instants" + PINNED,
         "AttitudeTracking-v0_self_triggered_stage2",
         "holds or eq. (27) × f from scratch, λ = 100 then 300, 3 seeds",
         "λ front: rule with a heartbeat or clocks, chosen per λ on validation",
@@ -137,7 +140,7 @@ BOARDS = (
         "003",
         "AsteroidOrbitKeeping-v0_self_triggered_front",
         "AsteroidOrbitKeeping-v0_self_triggered",
-        "eq. (15) at α/16 (cloned, kept by PPO)",
+        "eq. (15) at α/16; chosen on validation, cloned into a PPO policy that kept it (5 seeds)",
         "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=1",
         "holds or eq. (15) × f from scratch, λ = 1, 1 seed",
         "λ front: cloned from α/16, PPO at 4 λ",
@@ -147,7 +150,7 @@ BOARDS = (
         "004",
         "InnerFormation-v0_error_time_selected_front",
         "InnerFormation-v0_self_triggered_error_time",
-        "error-time rule at 6A (not the paper's: interval ∝ v^(-1/2))",
+        "error-time rule at 6A (not the paper's: interval ∝ v^(-1/2))" + PINNED,
         "InnerFormation-v0_self_triggered",
         "cloned from eqs. (4)-(6) at 2Π, then PPO, 5 seeds",
         "λ front: error-time rule or clocks, chosen per λ on validation",
@@ -299,7 +302,7 @@ def board_rows(records: Path, board: Board) -> list[Row]:
         ),
         Row(
             "best hand-designed rule",
-            board.best_label + "; chosen on validation, held by a pinned PPO policy",
+            board.best_label,
             best_record,
             {name: _record_measure(best, name, "learned") for name in SETS},
         ),
@@ -609,8 +612,8 @@ paper scenario ([`protocol.md`](protocol.md)). A row over several training seeds
 (rliable's stratified bootstrap over scenarios and seeds; seeds that recorded the same episodes
 count once); a sweep point keeps its `pareto.json` interval; the paper scenario is one episode
 per seed. The best hand-designed rule is a menu choice made on the validation set — a tuned
-baseline, not a learned trigger — judged as the PPO policy pinned to it, which took its actions
-exactly. The report is [`results.md`](results.md).
+baseline, not a learned trigger — judged as the self-triggered PPO policy started from it
+(pinned, on 003 cloned), which took exactly its actions. The report is [`results.md`](results.md).
 """
 
 
