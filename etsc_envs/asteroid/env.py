@@ -60,6 +60,7 @@ from etsc_envs.asteroid.dynamics import (
 from etsc_envs.asteroid.gravity import GRAVITATIONAL_CONSTANT
 from etsc_envs.asteroid.gravity_grid import collides
 from etsc_envs.asteroid.params import AsteroidParams
+from etsc_envs.asteroid.picture import PICTURE
 from etsc_envs.asteroid.shape import ShapeModel
 from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
@@ -163,6 +164,7 @@ class AsteroidOrbitKeepingEnv(EventTriggeredEnv):
     """
 
     kernels = KERNELS
+    picture = PICTURE
 
     def __init__(
         self,

@@ -38,6 +38,7 @@ from etsc_envs.attitude_tracking.dynamics import (
     tracking_error,
 )
 from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
+from etsc_envs.attitude_tracking.picture import PICTURE
 from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.rotations import quat_from_rotation_vector
@@ -92,6 +93,7 @@ class AttitudeTrackingEnv(EventTriggeredEnv):
     """
 
     kernels = KERNELS
+    picture = PICTURE
 
     def __init__(
         self,

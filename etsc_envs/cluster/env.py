@@ -41,6 +41,7 @@ from etsc_envs.cluster.closed_loop import (
 )
 from etsc_envs.cluster.dynamics import ClusterModel
 from etsc_envs.cluster.params import ClusterContainmentParams, replace_params
+from etsc_envs.cluster.picture import PICTURE
 from etsc_envs.cluster.topology import containment_targets
 from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
@@ -147,6 +148,7 @@ class ClusterContainmentCentralEnv(EventTriggeredEnv):
     """
 
     kernels = KERNELS
+    picture = PICTURE
 
     def __init__(
         self,

@@ -12,7 +12,8 @@ Observation bounds are the problem's where the physics bounds a component (the f
 norms, clocks); a component the paper bounds only asymptotically, by constants it does not
 state (observer estimates, sliding variables, trigger statistics), gets ±:data:`UNBOUNDED`, the
 largest float32, and its problem says so in its ``FEATURE_NAMES`` docs. ``render_mode=
-"rgb_array"`` draws the episode so far (:mod:`etsc_envs.core.render`).
+"rgb_array"`` draws the system (the problem's :attr:`EventTriggeredEnv.picture`) beside the
+episode so far, ``"human"`` shows it in a window (:mod:`etsc_envs.core.render`).
 
 A problem subclasses :class:`EventTriggeredEnv`, sets the class attribute ``kernels`` (its
 :class:`~etsc_envs.core.compiled_loop.ProblemKernels`) and implements four Python hooks:
@@ -44,11 +45,21 @@ from etsc_envs.core.compiled_loop import (
     make_loop_step,
 )
 from etsc_envs.core.metrics import communication_metrics
-from etsc_envs.core.render import RENDER_MODES, EpisodeTrace, draw_frame
+from etsc_envs.core.render import (
+    RENDER_FPS,
+    RENDER_MODES,
+    EpisodeTrace,
+    HumanWindow,
+    SystemPicture,
+    draw_frame,
+)
 from etsc_envs.core.validation import (
+    MAX_TRANSMISSION_PENALTY,
+    MIN_COST_SCALE,
     require_bool,
     require_choice,
     require_discount,
+    require_in_range,
     require_int_at_least,
     require_non_negative,
     require_positive,
@@ -82,16 +93,22 @@ class EventTriggeredEnv(gym.Env):
             ending an episode by diverging never pays more than staying in control.
         randomize: whether ``_reset_problem`` draws the episode's start (``True``/``False``
             only).
-        render_mode: ``None`` or ``"rgb_array"`` (:meth:`render` then draws the accuracy cost
-            and the transmission instants of the episode so far).
+        render_mode: ``None``, ``"rgb_array"`` (:meth:`render` returns the frame: the system
+            beside the accuracy cost and the transmission instants of the episode so far) or
+            ``"human"`` (the frames in a Matplotlib window, redrawn as the episode runs).
 
     ``reset()`` takes the ``options`` keys of :attr:`reset_options` (none by default) and
     refuses others. An env can be pickled at any point (the compiled entry is rebuilt on the
     next step) and the copy continues exactly as the original would.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": list(RENDER_MODES), "render_fps": 10}
+    metadata: ClassVar[dict[str, Any]] = {
+        "render_modes": list(RENDER_MODES),
+        "render_fps": RENDER_FPS,
+    }
     kernels: ClassVar[ProblemKernels]
+    picture: ClassVar[SystemPicture | None] = None
+    """How a frame draws the problem's system (``None``: the strips only)."""
     loop_step: ClassVar[Callable[..., None]]
     loop_interval: ClassVar[Callable[..., None]]
     reset_options: ClassVar[tuple[str, ...]] = ()
@@ -123,14 +140,17 @@ class EventTriggeredEnv(gym.Env):
     ) -> None:
         self.randomize = require_bool("randomize", randomize)
         self.render_mode = require_choice("render_mode", render_mode, (None, *RENDER_MODES))
-        self._trace = EpisodeTrace(n_channels) if render_mode is not None else None
         self.sampling_period_s = require_positive("sampling_period_s", sampling_period_s)
+        self._trace = (
+            EpisodeTrace(n_channels, self.sampling_period_s) if render_mode is not None else None
+        )
+        self._window = HumanWindow() if render_mode == "human" else None
         self.horizon_s = require_positive("horizon_s", horizon_s)
         self.n_steps = step_count(self.horizon_s, self.sampling_period_s)
-        self.transmission_penalty = require_non_negative(
-            "transmission_penalty", transmission_penalty
+        self.transmission_penalty = require_in_range(
+            "transmission_penalty", transmission_penalty, 0.0, MAX_TRANSMISSION_PENALTY
         )
-        self.cost_scale = require_positive("cost_scale", cost_scale)
+        self.cost_scale = require_in_range("cost_scale", cost_scale, MIN_COST_SCALE, np.inf)
         self.failure_cost = require_non_negative("failure_cost", failure_cost)
         self.n_channels = n_channels
         self.constants = constants
@@ -171,6 +191,8 @@ class EventTriggeredEnv(gym.Env):
         state["_loop_step_entry"] = None
         state["_loop_interval_entry"] = None
         state["_rule_interval_entries"] = {}
+        if self._window is not None:  # a window does not travel
+            state["_window"] = HumanWindow()
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -263,6 +285,8 @@ class EventTriggeredEnv(gym.Env):
         features = np.empty(self.n_features)
         self.kernels.features(self.state, self.constants, features)
         arrays.observation[0, : self.n_features] = features
+        if self._window is not None:
+            self.render()
         return arrays.observation[0].copy(), self.reset_info()
 
     @staticmethod
@@ -436,25 +460,53 @@ class EventTriggeredEnv(gym.Env):
     def trace_step(self) -> None:
         """Note the step just taken for :meth:`render` (nothing unless rendering)."""
         if self._trace is not None:
-            self._trace.record(self.time_s, float(self.arrays.cost[0]), self.arrays.sent[0])
+            self._trace.record(self.step_index - 1, float(self.arrays.cost[0]), self.arrays.sent[0])
+            self._redraw_window()
 
     def trace_interval(self, start: int, costs: np.ndarray, sent: np.ndarray) -> None:
         """Note the ``len(costs)`` steps just run after instant ``start`` in one compiled call
         (each step's accuracy cost and transmit bits) for :meth:`render`."""
         if self._trace is not None:
             for instant, cost in enumerate(costs):
-                time_s = (start + instant + 1) * self.sampling_period_s
-                self._trace.record(time_s, float(cost), sent[instant])
+                self._trace.record(start + instant, float(cost), sent[instant])
+            self._redraw_window()
+
+    def _redraw_window(self) -> None:
+        """``render_mode="human"``: redraw the window if a frame is due."""
+        if self._window is not None and self._window.due():
+            self.render()
 
     def render(self) -> np.ndarray | None:
-        """With ``render_mode="rgb_array"``, the episode so far as an RGB array: the accuracy
-        cost per step over time and each channel's transmission instants; ``None`` otherwise."""
+        """The frame of the current instant: the system (the problem's :attr:`picture`, with a
+        trail through the states of the episode's earlier frames) beside the accuracy cost per
+        step and each channel's transmission instants so far. ``render_mode="rgb_array"``
+        returns it as an RGB array; ``"human"`` shows it in the window and returns ``None``, as
+        does an env without a render mode."""
         if self._trace is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode='rgb_array'")
+            gym.logger.warn(
+                f"render() called without a render_mode; pass render_mode as one of {RENDER_MODES}"
+            )
             return None
         transmissions = int(self.transmissions.sum())
         title = f"{type(self).__name__}   t = {self.time_s:.3f} s   transmissions = {transmissions}"
-        return draw_frame(self._trace, self.channel_labels, title)
+        system = None
+        picture = self.picture
+        if picture is not None:
+            trail = self._trace.note_snapshot(self.time_s, picture.snapshot(self))
+
+            def system(figure, region):
+                picture.draw(self, figure, region, trail)
+
+        frame = draw_frame(self._trace, self.channel_labels, title, self.horizon_s, system)
+        if self._window is not None:
+            self._window.show(frame)
+            return None
+        return frame
+
+    def close(self) -> None:
+        if self._window is not None:
+            self._window.close()
+        super().close()
 
     @property
     def channel_labels(self) -> tuple[str, ...]:

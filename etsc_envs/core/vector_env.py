@@ -35,8 +35,12 @@ from etsc_envs.core.compiled_loop import (
     loop_rule_interval,
 )
 from etsc_envs.core.loop_env import EventTriggeredEnv
-from etsc_envs.core.render import RENDER_MODES
-from etsc_envs.core.validation import require_reset_options, require_rule_trigger
+from etsc_envs.core.render import RENDER_FPS
+from etsc_envs.core.validation import (
+    require_choice,
+    require_reset_options,
+    require_rule_trigger,
+)
 
 ROWS_PER_THREAD_MIN = 8
 """A batch gets one more thread for every this many rows, up to one per available core
@@ -71,6 +75,10 @@ def _row_chunks(num_envs: int, workers: int) -> list[tuple[int, int]]:
     return [(int(bounds[k]), int(bounds[k + 1])) for k in range(workers)]
 
 
+VECTOR_RENDER_MODES = ("rgb_array",)
+"""The render modes of a vector environment besides ``None``."""
+
+
 class EventTriggeredVectorEnv(VectorEnv):
     """``num_envs`` environments of ``single_env_class`` stepped together.
 
@@ -79,7 +87,8 @@ class EventTriggeredVectorEnv(VectorEnv):
         autoreset_mode: ``"next_step"`` (default), ``"same_step"`` or ``"disabled"`` (or the
             :class:`gymnasium.vector.AutoresetMode` itself).
         render_mode: ``None`` or ``"rgb_array"``: :meth:`render` then returns one frame per
-            sub-environment (see :meth:`EventTriggeredEnv.render`).
+            sub-environment (see :meth:`EventTriggeredEnv.render`); ``"human"`` (a window per
+            sub-environment) is refused.
         **env_kwargs: passed to every sub-environment's constructor.
 
     Subclasses set ``single_env_class``; ``envs`` holds the sub-environments (for their
@@ -87,8 +96,8 @@ class EventTriggeredVectorEnv(VectorEnv):
     """
 
     metadata: ClassVar[dict[str, Any]] = {
-        "render_modes": list(RENDER_MODES),
-        "render_fps": 10,
+        "render_modes": list(VECTOR_RENDER_MODES),
+        "render_fps": RENDER_FPS,
         "autoreset_mode": AutoresetMode.NEXT_STEP,
     }
     single_env_class: ClassVar[type[EventTriggeredEnv]]
@@ -105,6 +114,7 @@ class EventTriggeredVectorEnv(VectorEnv):
             raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
         if num_envs < 1:
             raise ValueError(f"num_envs must be an integer >= 1, got {num_envs}")
+        require_choice("render_mode", render_mode, (None, *VECTOR_RENDER_MODES))
         mode = _autoreset_mode(autoreset_mode)
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.autoreset_mode = mode

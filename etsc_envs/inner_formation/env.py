@@ -39,6 +39,7 @@ from etsc_envs.inner_formation.controller import ObserverFeedback
 from etsc_envs.inner_formation.design import estimation_bounds, zeno_bound_s
 from etsc_envs.inner_formation.dynamics import RelativeMotionModel, lumped_term
 from etsc_envs.inner_formation.params import InnerFormationParams
+from etsc_envs.inner_formation.picture import PICTURE
 
 AXES = ("x", "y", "z")
 FEATURE_NAMES = (
@@ -95,6 +96,7 @@ class InnerFormationEnv(EventTriggeredEnv):
     """
 
     kernels = KERNELS
+    picture = PICTURE
 
     def __init__(
         self,

@@ -67,6 +67,7 @@ from etsc_envs.orbit_attitude.dynamics import (
     thruster_outputs,
 )
 from etsc_envs.orbit_attitude.params import OrbitAttitudeParams
+from etsc_envs.orbit_attitude.picture import PICTURE
 
 _AXES = ("x", "y", "z")
 FEATURE_NAMES = (
@@ -258,6 +259,7 @@ class OrbitAttitudeTrackingEnv(EventTriggeredEnv):
     """
 
     kernels = KERNELS
+    picture = PICTURE
 
     def __init__(
         self,
