@@ -89,7 +89,8 @@ import dataclasses
 import importlib
 import importlib.util
 import inspect
-from collections.abc import Iterable, Mapping
+import math
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -506,9 +507,30 @@ def _check_hyperparameter(name: str, value: Any, default: Any) -> None:
         if not isinstance(value, bool):
             raise ValueError(f"config key {key!r} must be true or false, got {value!r}")
     elif isinstance(default, int | float) and (
-        isinstance(value, bool) or not isinstance(value, int | float)
+        isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value)
     ):
-        raise ValueError(f"config key {key!r} must be a number, got {value!r}")
+        raise ValueError(f"config key {key!r} must be a finite number, got {value!r}")
+    if name in HYPERPARAMETER_RANGES and isinstance(value, int | float):
+        inside, allows = HYPERPARAMETER_RANGES[name]
+        if not inside(value):
+            raise ValueError(f"config key {key!r} must be {allows}, got {value!r}")
+
+
+HYPERPARAMETER_RANGES: dict[str, tuple[Callable[[float], bool], str]] = {
+    "gamma": (lambda v: 0.0 < v <= 1.0, "in (0, 1]"),
+    "gae_lambda": (lambda v: 0.0 < v <= 1.0, "in (0, 1]"),
+    "learning_rate": (lambda v: v > 0.0, "> 0"),
+    "clip_range": (lambda v: v > 0.0, "> 0"),
+    "max_grad_norm": (lambda v: v > 0.0, "> 0"),
+    "ent_coef": (lambda v: v >= 0.0, ">= 0"),
+    "vf_coef": (lambda v: v >= 0.0, ">= 0"),
+    "tau": (lambda v: 0.0 < v <= 1.0, "in (0, 1]"),
+    "exploration_fraction": (lambda v: 0.0 <= v <= 1.0, "in [0, 1]"),
+    "exploration_initial_eps": (lambda v: 0.0 <= v <= 1.0, "in [0, 1]"),
+    "exploration_final_eps": (lambda v: 0.0 <= v <= 1.0, "in [0, 1]"),
+}
+"""The algorithms' hyperparameters that have a range: the discount and GAE's lambda (a
+discount above 1 sums returns that grow without bound), rates and coefficients."""
 
 
 def _constructor_arguments(algorithm_class: type[BaseAlgorithm]) -> list[str]:

@@ -99,6 +99,14 @@ def evaluate(
         seeds, described = [seed + episode for episode in range(episodes)], None
     edges = None if windows_s is None else window_edges(windows_s)
     setup = episode_setup(env_id, env_args)
+    if edges is not None:
+        horizon_s = _horizon_s(setup.env)
+        if edges[-1] > horizon_s * (1.0 + 1e-12):
+            setup.env.close()
+            raise ValueError(
+                f"--windows: every edge must lie inside the episode's horizon of "
+                f"{horizon_s:g} s, got {', '.join(f'{edge:g}' for edge in edges)}"
+            )
     trigger = setup.make_policy(policy, policy_args)
     records: list[dict[str, Any]] = []
     try:
@@ -218,7 +226,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument(
         "--set-size",
-        type=int,
+        type=_positive_integer,
         default=DEFAULT_SET_SIZE,
         metavar="K",
         help=f"scenarios of the validation or test set (default {DEFAULT_SET_SIZE})",
@@ -283,6 +291,23 @@ def main(argv: list[str] | None = None) -> int:
     summary = sys.stderr if args.json == "-" else sys.stdout
     print(_summary_text(result), file=summary)
     return 0
+
+
+def _horizon_s(env: Any) -> float:
+    """The episode length of ``env`` (a Gymnasium env or a PettingZoo parallel env)."""
+    unwrapped = env.unwrapped
+    return float(getattr(unwrapped, "loop", unwrapped).horizon_s)
+
+
+def _positive_integer(text: str) -> int:
+    """``--set-size``: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"takes an integer >= 1 (scenarios), got {text!r}")
+    return value
 
 
 def _window_edges_argument(text: str) -> tuple[float, ...]:

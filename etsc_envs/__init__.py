@@ -77,13 +77,24 @@ def _require_pettingzoo_id(env_id: str) -> str:
 def make_parallel(env_id: str, **kwargs: Any) -> pettingzoo.ParallelEnv:
     """``pettingzoo.make("parallel", env_id, **kwargs)`` for an id of this package
     (``ValueError`` for any other id)."""
-    return pettingzoo.make("parallel", _require_pettingzoo_id(env_id), **kwargs)
+    return pettingzoo.make("parallel", _require_pettingzoo_id(env_id), **_checked_cycles(kwargs))
 
 
 def make_aec(env_id: str, **kwargs: Any) -> pettingzoo.AECEnv:
     """``pettingzoo.make("aec", env_id, **kwargs)``: the AEC form with PettingZoo's usual
     wrappers (``ValueError`` for an id not of this package)."""
-    return pettingzoo.make("aec", _require_pettingzoo_id(env_id), **kwargs)
+    return pettingzoo.make("aec", _require_pettingzoo_id(env_id), **_checked_cycles(kwargs))
+
+
+def _checked_cycles(kwargs: dict[str, Any]) -> dict[str, Any]:
+    """``kwargs``, or ``ValueError`` for a ``max_cycles`` the envs refuse (PettingZoo's
+    ``make`` reads -1 as "no limit" and drops it; the envs take ``None`` for that)."""
+    cycles = kwargs.get("max_cycles")
+    if cycles is not None and (
+        isinstance(cycles, bool) or not isinstance(cycles, int) or cycles < 1
+    ):
+        raise ValueError(f"max_cycles must be None or an integer >= 1, got {cycles!r}")
+    return kwargs
 
 
 def load_policy(path: str, env: Any) -> Any:

@@ -33,4 +33,17 @@ def raw_env(**kwargs: Any) -> AECEnv:
 
 def env(**kwargs: Any) -> AECEnv:
     """The AEC form with PettingZoo's usual wrappers (action bounds, call order)."""
-    return wrappers.OrderEnforcingWrapper(wrappers.AssertOutOfBoundsWrapper(raw_env(**kwargs)))
+    return wrappers.OrderEnforcingWrapper(ActionChecked(raw_env(**kwargs)))
+
+
+class ActionChecked(wrappers.AssertOutOfBoundsWrapper):
+    """PettingZoo's bounds check, refusing an action outside the agent's space with one
+    ``ValueError`` line naming the agent and the actions it takes (not a bare assertion)."""
+
+    def step(self, action: Any) -> None:
+        agent = self.agent_selection
+        done = self.terminations[agent] or self.truncations[agent]
+        if not (action is None and done) and not self.action_space(agent).contains(action):
+            allowed = "None (its episode is over)" if done else "0 (hold) or 1 (transmit)"
+            raise ValueError(f"action of {agent} must be {allowed}, got {action!r}")
+        super().step(action)

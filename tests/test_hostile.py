@@ -1022,3 +1022,219 @@ def test_an_interrupted_process_sweep_says_how_to_resume(tmp_path: Path) -> None
     assert process.returncode == 130, stderr
     assert "Traceback" not in stderr, stderr
     assert "--processes 1 --resume" in stderr.strip().splitlines()[-1], stderr
+
+
+# ----------------------------------------------------------------------- ranges (issue 41)
+@pytest.mark.parametrize("env_id", GYM_IDS)
+def test_the_smallest_accepted_cost_scale_keeps_rewards_finite(env_id: str) -> None:
+    from etsc_envs.core.validation import MAX_TRANSMISSION_PENALTY, MIN_COST_SCALE
+
+    with pytest.raises(ValueError) as error:
+        gym.make(env_id, cost_scale=1e-320)
+    assert_one_line(error, "cost_scale", "[1e-06")
+    with pytest.raises(ValueError) as error:
+        gym.make(env_id, transmission_penalty=1e308)
+    assert_one_line(error, "transmission_penalty", "1e+12")
+    env = gym.make(
+        env_id,
+        cost_scale=MIN_COST_SCALE,
+        transmission_penalty=MAX_TRANSMISSION_PENALTY,
+        **SHORT[env_id],
+    )
+    env.reset(seed=0)
+    for _ in range(3):
+        _, reward, terminated, truncated, _ = env.step(bits(env, 1))
+        assert np.isfinite(reward)
+        if terminated or truncated:
+            break
+
+
+@pytest.mark.parametrize("duration", [0.1, 0.3, 0.0])
+def test_asteroid_burst_is_a_whole_number_of_steps(duration: float) -> None:
+    with pytest.raises(ValueError) as error:
+        gym.make("etsc/AsteroidOrbitKeeping-v0", burst_duration_s=duration)
+    assert_one_line(error, "burst_duration_s")
+    gym.make("etsc/AsteroidOrbitKeeping-v0", burst_duration_s=0.5)
+
+
+def test_a_near_singular_inertia_is_refused() -> None:
+    with pytest.raises(ValueError) as error:
+        gym.make("etsc/AttitudeTracking-v0", nominal_inertia=np.diag([1.0, 1.0, 1e-17]))
+    assert_one_line(error, "nominal_inertia", "well conditioned")
+
+
+@pytest.mark.parametrize("maker", ["make_parallel", "make_aec"])
+def test_make_parallel_refuses_the_max_cycles_the_module_refuses(maker: str) -> None:
+    from etsc_envs import cluster_containment_v0
+
+    for make in (getattr(etsc_envs, maker), None):
+        with pytest.raises(ValueError) as error:
+            if make is None:
+                cluster_containment_v0.parallel_env(max_cycles=-1)
+            else:
+                make(PETTINGZOO_ID, max_cycles=-1)
+        assert_one_line(error, "max_cycles", ">= 1", "-1")
+
+
+def test_pettingzoo_actions_name_what_they_allow() -> None:
+    from etsc_envs import cluster_containment_v0
+
+    parallel = etsc_envs.make_parallel(PETTINGZOO_ID, horizon_s=0.5)
+    parallel.reset(seed=0)
+    with pytest.raises(ValueError) as error:
+        parallel.step(None)
+    assert_one_line(error, "actions must be a dict", "follower_0", "None")
+    aec = cluster_containment_v0.env(horizon_s=0.5)
+    aec.reset(seed=0)
+    with pytest.raises(ValueError) as error:
+        aec.step(2)
+    assert_one_line(error, "action of follower_0", "0 (hold) or 1 (transmit)", "2")
+
+
+@pytest.mark.parametrize(
+    ("change", "key"),
+    [
+        ({"gamma": 1.5}, "gamma"),
+        ({"gamma": 0.0}, "gamma"),
+        ({"gae_lambda": 1.2}, "gae_lambda"),
+        ({"learning_rate": -1e-3}, "learning_rate"),
+        ({"learning_rate": float("nan")}, "learning_rate"),
+        ({"ent_coef": -0.1}, "ent_coef"),
+    ],
+)
+def test_config_refuses_hyperparameters_out_of_range(tmp_path: Path, change, key) -> None:
+    pytest.importorskip("stable_baselines3")
+    from agents.config import config_from_dict
+
+    hyperparameters = {"n_steps": 64, "batch_size": 64, "n_epochs": 1, **change}
+    with pytest.raises(ValueError) as error:
+        config_from_dict(tiny_training_config(tmp_path / "run", hyperparameters=hyperparameters))
+    assert_one_line(error, f"hyperparameters.{key}")
+
+
+EVALUATE_FINDINGS = [
+    (["--env-arg", "initial_rate=[0,0"], "--env-arg initial_rate"),
+    (["--policy-arg", "psi=abc"], "--policy-arg psi must be a finite number"),
+    (["--policy-arg", "heartbeat=abc"], "--policy-arg heartbeat must be an integer >= 1"),
+    (["--policy-arg", "foo=1"], "--policy-arg foo: paper on etsc/AttitudeTracking-v0 takes"),
+    (["--scenarios", "paper", "--set-size", "-4"], "--set-size"),
+    (["--windows", "10,20"], "--windows: every edge must lie inside"),
+]
+
+
+@pytest.mark.parametrize(("extra", "expected"), EVALUATE_FINDINGS)
+def test_evaluate_names_the_argument_and_what_it_allows(capsys, extra, expected) -> None:
+    from baselines.evaluate import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--policy", "paper", "--env-arg=horizon_s=0.05", *extra])
+    assert exit_info.value.code == 2
+    assert expected in _error_line(capsys)
+
+
+@pytest.mark.parametrize(
+    ("policy", "argument", "expected"),
+    [
+        ("sb3:", None, "--policy sb3: needs the path of a model zip"),
+        ("periodic", "every=nan", "--policy-arg every must be an integer >= 1"),
+        ("always", "every=3", "always on etsc/AttitudeTracking-v0 takes no --policy-arg"),
+    ],
+)
+def test_policy_specs_name_what_they_take(capsys, policy, argument, expected) -> None:
+    from baselines.evaluate import main
+
+    extra = [] if argument is None else ["--policy-arg", argument]
+    with pytest.raises(SystemExit):
+        main(["etsc/AttitudeTracking-v0", "--policy", policy, "--env-arg=horizon_s=0.05", *extra])
+    assert expected in _error_line(capsys)
+
+
+def test_pareto_refuses_a_reuse_file_that_is_not_json(tmp_path: Path, capsys) -> None:
+    from agents.pareto import main
+
+    not_json = tmp_path / "notjson.zip"
+    not_json.write_bytes(b"PK\x03\x04")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["etsc/AttitudeTracking-v0", "--reuse", str(not_json), "--out", str(tmp_path / "o")])
+    assert exit_info.value.code == 2
+    assert "--reuse: takes the pareto.json of an earlier run" in _error_line(capsys)
+
+
+# ----------------------------------------------------------------------- properties (hypothesis)
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+ANY_VALUE = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(min_value=-(10**6), max_value=10**6),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=8),
+    st.lists(st.floats(allow_nan=False, width=32), max_size=4),
+)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    keyword=st.sampled_from(["cost_scale", "transmission_penalty", "horizon_s", "randomize"]),
+    value=ANY_VALUE,
+)
+def test_property_a_keyword_value_is_refused_by_name_or_runs_finite(keyword, value) -> None:
+    env_id = "etsc/AttitudeTracking-v0"
+    kwargs = {"horizon_s": 0.05, keyword: value}
+    try:
+        env = gym.make(env_id, **kwargs)
+    except (ValueError, TypeError) as error:
+        message = str(error)
+        assert "\n" not in message and keyword in message, message
+        return
+    observation, _ = env.reset(seed=0)
+    for _ in range(min(env.unwrapped.n_steps, 5)):
+        observation, reward, terminated, truncated, _ = env.step(1)
+        assert np.isfinite(reward) and np.all(np.isfinite(observation))
+        if terminated or truncated:
+            break
+
+
+@settings(max_examples=30, deadline=None)
+@given(action=st.one_of(ANY_VALUE, st.integers(), st.dictionaries(st.text(max_size=3), ANY_VALUE)))
+def test_property_a_pettingzoo_action_is_refused_with_one_line_or_taken(action) -> None:
+    parallel = etsc_envs.make_parallel(PETTINGZOO_ID, horizon_s=0.5)
+    parallel.reset(seed=0)
+    try:
+        parallel.step(action)
+    except ValueError as error:
+        assert "\n" not in str(error) and "action" in str(error)
+    else:  # only a dict of 0/1 per agent is taken
+        assert isinstance(action, dict)
+
+
+@settings(
+    max_examples=20,
+    deadline=None,  # capsys is read out at the start of every input
+    suppress_health_check=[hypothesis.HealthCheck.function_scoped_fixture],
+)
+@given(
+    option=st.sampled_from(["--policy-arg", "--env-arg"]),
+    key=st.sampled_from(["psi", "every", "heartbeat", "floor", "initial_rate", "x"]),
+    value=st.text(
+        alphabet=st.characters(min_codepoint=32, max_codepoint=126, blacklist_characters="\\"),
+        max_size=6,
+    ),
+)
+def test_property_a_command_line_value_is_refused_with_one_line_naming_it(
+    option, key, value, capsys
+) -> None:
+    from baselines.evaluate import main
+
+    capsys.readouterr()
+    arguments = ["etsc/AttitudeTracking-v0", "--policy", "paper", "--env-arg=horizon_s=0.005"]
+    try:
+        status = main([*arguments, option, f"{key}={value}"])
+    except SystemExit as exit_info:
+        assert exit_info.code == 2
+        line = _error_line(capsys)
+        assert option in line or key in line, line
+    else:
+        assert status == 0

@@ -189,6 +189,12 @@ class AsteroidParams:
                 "grid_spacing_m must be at most half the width of operating_region_m, "
                 f"got {self.grid_spacing_m}"
             )
+        bursts = self.burst_duration_s / self.sampling_period_s
+        if round(bursts) < 1 or not np.isclose(bursts, round(bursts), rtol=0.0, atol=1e-9):
+            raise ValueError(
+                f"burst_duration_s must be a whole number (>= 1) of sampling periods of "
+                f"{self.sampling_period_s:g} s, got {self.burst_duration_s!r}"
+            )
         if self.horizon_s < self.burst_duration_s:
             raise ValueError(
                 f"horizon_s must be >= burst_duration_s ({self.burst_duration_s}), "

@@ -24,6 +24,7 @@ central env's reward.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -240,6 +241,11 @@ class EventTriggeredParallelEnv(ParallelEnv):
     def _bits(self, actions: dict[str, Any]) -> np.ndarray:
         """One 0/1 per agent, or ``ValueError`` naming the agent or action that is wrong."""
         names = self.possible_agents
+        if not isinstance(actions, Mapping):
+            raise ValueError(
+                f"actions must be a dict of one action, 0 (hold) or 1 (transmit), per live agent "
+                f"({', '.join(names)}), got {actions!r}"
+            )
         if len(actions) != len(names) or any(agent not in actions for agent in names):
             missing = [agent for agent in names if agent not in actions]
             unknown = sorted(set(actions) - set(names))

@@ -129,11 +129,20 @@ def require_spd_matrix(name: str, value: Iterable[Iterable[float]]) -> np.ndarra
         raise ValueError(f"{name} must be a finite 3x3 matrix, got shape {matrix.shape}")
     if not np.allclose(matrix, matrix.T, rtol=0.0, atol=1e-12 * max(1.0, np.abs(matrix).max())):
         raise ValueError(f"{name} must be symmetric, got {matrix.tolist()}")
-    if np.linalg.eigvalsh(matrix).min() <= 0.0:
+    eigenvalues = np.linalg.eigvalsh(matrix)
+    if eigenvalues.min() <= 0.0:
+        raise ValueError(f"{name} must be positive definite, got eigenvalues {eigenvalues}")
+    if eigenvalues.max() > MAX_CONDITION_NUMBER * eigenvalues.min():
         raise ValueError(
-            f"{name} must be positive definite, got eigenvalues {np.linalg.eigvalsh(matrix)}"
+            f"{name} must be well conditioned (largest / smallest eigenvalue <= "
+            f"{MAX_CONDITION_NUMBER:g}), got eigenvalues {eigenvalues}"
         )
     return matrix
+
+
+MAX_CONDITION_NUMBER = 1e8
+"""The largest ratio of a matrix parameter's eigenvalues (an inertia): beyond it, solving with
+the matrix in float64 loses more than half of its digits."""
 
 
 def step_count(horizon_s: float, sampling_period_s: float) -> int:
@@ -222,3 +231,20 @@ def apply_overrides(params_class: type, params: Any, overrides: dict[str, Any], 
     if unknown:
         raise TypeError(f"unknown argument(s) for {owner}: {sorted(unknown)}")
     return dataclasses.replace(params, **overrides)
+
+
+MIN_COST_SCALE = 1e-6
+"""The smallest ``cost_scale``: a finite cost below ~1e302 then gives a finite reward."""
+MAX_TRANSMISSION_PENALTY = 1e12
+"""The largest ``transmission_penalty``: its charge for every channel stays finite and leaves
+the accuracy term digits to count in."""
+
+
+def require_in_range(name: str, value: Any, low: float, high: float) -> float:
+    """``value`` as a float in ``[low, high]``, or ``ValueError`` naming ``name`` and the range."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise ValueError(f"{name} must be a number in [{low:g}, {high:g}], got {value!r}")
+    number = float(value)
+    if not low <= number <= high:
+        raise ValueError(f"{name} must be a number in [{low:g}, {high:g}], got {value!r}")
+    return number
