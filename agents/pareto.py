@@ -458,6 +458,21 @@ def plot(result: dict[str, Any], path: Path) -> None:
     save(figure, path)
 
 
+def _earlier_result(text: str) -> dict[str, Any]:
+    """``--reuse``: the ``pareto.json`` of an earlier run, read as a JSON object."""
+    try:
+        reuse = json.loads(Path(text).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        raise argparse.ArgumentTypeError(
+            f"takes the pareto.json of an earlier run, got {text!r} ({type(error).__name__})"
+        ) from None
+    if not isinstance(reuse, dict):
+        raise argparse.ArgumentTypeError(
+            f"takes the pareto.json of an earlier run, got {text!r} (not a JSON object)"
+        )
+    return reuse
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m agents.pareto",
@@ -490,7 +505,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
     parser.add_argument(
         "--reuse",
-        type=Path,
+        type=_earlier_result,
         metavar="PARETO_JSON",
         help="keep the paper and periodic curves of an earlier run; run only the models",
     )
@@ -500,7 +515,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         require_writable_folder(out_dir, "--out")
         env_kwargs = parse_assignments(args.env_arg, "--env-arg")
-        reuse = json.loads(args.reuse.read_text(encoding="utf-8")) if args.reuse else None
+        reuse = args.reuse
         models, methods = list(args.model), [LEARNED] * len(args.model)
         for results_dir in args.sweep:
             found = sweep_models([results_dir], args.env_id)

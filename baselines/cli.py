@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import inspect
 import json
+import math
 import sys
 from collections.abc import Callable
 from typing import Any, NamedTuple
@@ -67,12 +69,58 @@ def parse_assignments(pairs: list[str] | None, option: str) -> dict[str, Any]:
         key, sep, value = pair.partition("=")
         if not sep or not key:
             raise ValueError(f"{option} takes key=value, got {pair!r}")
-        parsed[key] = parse_value(value)
+        try:
+            parsed[key] = parse_value(value)
+        except yaml.YAMLError as error:
+            problem = getattr(error, "problem", None) or type(error).__name__
+            raise ValueError(
+                f"{option} {key}: {value!r} is not a number, a list such as [0, 0, 0] or a "
+                f"YAML value ({problem})"
+            ) from None
     return parsed
+
+
+def check_policy_arguments(spec: str, policy_args: dict[str, Any], env_id: str) -> None:
+    """``ValueError`` naming the ``--policy-arg`` that ``spec`` does not take, or whose value is
+    not of its kind, with the keywords it takes: the rules' thresholds are finite numbers, every
+    count of sampling instants (``every``, ``heartbeat``, ``floor``, ...) an integer >= 1.
+    Other specs (models) are checked where they are loaded."""
+    if spec.startswith("sb3:") and not spec.removeprefix("sb3:"):
+        raise ValueError("--policy sb3: needs the path of a model zip, e.g. sb3:models/NAME.zip")
+    counts = {"every", "then_every", "switch_after"} if spec == "periodic" else set()
+    numbers: set[str] = set()
+    if spec in RULE_FAMILIES and env_id in RULE_FAMILIES[spec][0]:
+        trigger_class = RULE_FAMILIES[spec][0][env_id]
+        parameters = list(inspect.signature(trigger_class.__init__).parameters)
+        numbers = set(parameters[4:])  # after self, the two spaces and the observation names
+        counts = {"heartbeat", "floor", "channel_heartbeat"}
+    elif spec not in ("always", "periodic"):
+        return
+    for key, value in policy_args.items():
+        if key not in counts | numbers:
+            takes = ", ".join(sorted(counts | numbers)) or "no --policy-arg"
+            raise ValueError(
+                f"--policy-arg {key}: {spec} on {env_id} takes {takes}, got {key}={value!r}"
+            )
+        least = 0 if key == "switch_after" else 1
+        if key in counts and (
+            isinstance(value, bool) or not isinstance(value, int) or value < least
+        ):
+            raise ValueError(
+                f"--policy-arg {key} must be an integer >= {least} (sampling instants), "
+                f"got {value!r}"
+            )
+        if key in numbers and (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or not math.isfinite(value)
+        ):
+            raise ValueError(f"--policy-arg {key} must be a finite number, got {value!r}")
 
 
 def make_policy(spec: str, env: gym.Env, policy_args: dict[str, Any], env_id: str) -> Any:
     """The policy named by ``spec`` (see :data:`POLICY_CHOICES`) for ``env``."""
+    check_policy_arguments(spec, policy_args, env_id)
     return _policy_for(
         spec,
         env.observation_space,
@@ -97,6 +145,7 @@ def make_agent_policy(spec: str, env: Any, policy_args: dict[str, Any], env_id: 
         for other in env.possible_agents
     ):
         raise ValueError(f"the agents of {env_id} differ in their spaces; no policy serves all")
+    check_policy_arguments(spec, policy_args, env_id)
     return _policy_for(
         spec,
         env.observation_space(agent),
