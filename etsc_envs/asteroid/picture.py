@@ -7,7 +7,9 @@ by the Sun; the safe shell r_0 ± ``shell_half_width_m`` that paper 003's barrie
 keeps the orbit in (green), the reference circle r_0 (dashed) and the operating region's
 bounds (dotted); the spacecraft's trail through the episode's frames and the spacecraft
 (an orange star while a thrust burst of eqs. (16)-(17) fires). Below, ‖r‖ - r_0 over the
-episode against the shell, where a 5-m band on a 200-m orbit becomes visible.
+episode against the shell, where a 5-m band on a 200-m orbit becomes visible: one dot per
+frame (the radius oscillates between bursts faster than frames are usually drawn, so the dots
+are samples, not a curve).
 """
 
 from __future__ import annotations
@@ -71,7 +73,7 @@ def draw(env: Any, figure: Figure, region: SubplotSpec, trail: np.ndarray) -> No
     strip = figure.add_subplot(radius_cell)
     error = np.linalg.norm(trail[:, 1:4], axis=1) - r0
     strip.axhspan(-half, half, color=SHELL_COLOR, alpha=0.3, lw=0)
-    strip.plot(trail[:, 0], error, color="black", linewidth=0.9)
+    strip.plot(trail[:, 0], error, "o", color="black", markersize=2.0)
     reach = max(1.6 * half, 1.1 * float(np.abs(error).max()))
     strip.set_ylim(-reach, reach)
     strip.set_xlim(0.0, env.horizon_s)
