@@ -101,11 +101,12 @@ def evaluate(
     setup = episode_setup(env_id, env_args)
     if edges is not None:
         horizon_s = _horizon_s(setup.env)
-        if edges[-1] > horizon_s * (1.0 + 1e-12):
+        if edges[0] >= horizon_s:
             setup.env.close()
             raise ValueError(
-                f"--windows: every edge must lie inside the episode's horizon of "
-                f"{horizon_s:g} s, got {', '.join(f'{edge:g}' for edge in edges)}"
+                f"--windows: the first window must start inside the episode's horizon of "
+                f"{horizon_s:g} s (else every window is empty), got "
+                f"{', '.join(f'{edge:g}' for edge in edges)}"
             )
     trigger = setup.make_policy(policy, policy_args)
     records: list[dict[str, Any]] = []

@@ -8,9 +8,11 @@ deterministic=True) -> (action, state)``.
 
 from __future__ import annotations
 
+import base64
 import inspect
 import io
 import json
+import pickletools
 import zipfile
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -39,7 +41,8 @@ def read_model_record(path: str | Path) -> dict[str, Any]:
     its attributes. The record returned keeps the plain values, with ``policy_module`` (the
     policy class's module), ``observation_space`` and ``action_space`` rebuilt from those
     attributes (:func:`_space_from_record`; a ``Box`` with unbounded limits: a policy reads
-    only its shape and dtype), and ``serialized`` (the names of the pickled entries)."""
+    only its shape and dtype), and ``serialized`` (each pickled entry's base64 text, never
+    unpickled)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"sb3 model file not found: {path}")
@@ -49,7 +52,9 @@ def read_model_record(path: str | Path) -> dict[str, Any]:
         if not isinstance(stored, dict):
             raise ValueError("its data record is not a JSON object")
         serialized = {
-            key for key, value in stored.items() if isinstance(value, dict) and SERIALIZED in value
+            key: value[SERIALIZED]
+            for key, value in stored.items()
+            if isinstance(value, dict) and SERIALIZED in value
         }
         record = {key: value for key, value in stored.items() if key not in serialized}
         record["serialized"] = serialized
@@ -87,6 +92,42 @@ def _space_from_record(entry: dict[str, Any]) -> gym.Space:
     raise ValueError(
         f"a space of {kind} (the suite loads Box, Discrete, MultiBinary, MultiDiscrete)"
     )
+
+
+def _pickled_names(blob: str) -> set[str]:
+    """The ``module.name`` globals a base64 pickle refers to, read from its opcodes without
+    unpickling it."""
+    names, strings = set(), []
+    for opcode, argument, _ in pickletools.genops(base64.b64decode(blob)):
+        if isinstance(argument, str):
+            strings.append(argument)
+        if opcode.name == "GLOBAL":
+            names.add(argument.replace(" ", "."))
+        elif opcode.name == "STACK_GLOBAL" and len(strings) >= 2:
+            names.add(f"{strings[-2]}.{strings[-1]}")
+    return names
+
+
+def _default_policy_kwargs(
+    path: str | Path, blob: str, algorithm: type, objects: dict[str, Any]
+) -> dict[str, Any]:
+    """The ``policy_kwargs`` to load ``path`` with when SB3 pickled them: the algorithm's own
+    defaults (A2C's RMSprop optimizer, which SB3 stores as a class), if the pickle names no
+    other class; else ``ValueError`` (custom activations or layers would act otherwise)."""
+    model = algorithm(objects["policy_class"], env=None, _init_setup_model=False)
+    defaults = dict(model.policy_kwargs)
+    allowed = {
+        f"{value.__module__}.{value.__qualname__}"
+        for value in defaults.values()
+        if isinstance(value, type)
+    }
+    names = _pickled_names(blob)
+    if not names <= allowed:
+        raise ValueError(
+            f"{path}: its policy_kwargs name {sorted(names - allowed)}, which the suite does not "
+            "load (unpickling runs whatever code the file carries; see docs/security.md)"
+        )
+    return defaults
 
 
 ACTING_PLACEHOLDERS: dict[str, Any] = {
@@ -132,7 +173,11 @@ def safe_load_objects(
         "observation_space": observation_space or record["observation_space"],
         "action_space": action_space or record["action_space"],
     }
-    others = sorted(record["serialized"] - set(objects) - set(ACTING_PLACEHOLDERS))
+    if "policy_kwargs" in record["serialized"]:
+        objects["policy_kwargs"] = _default_policy_kwargs(
+            path, record["serialized"]["policy_kwargs"], algorithm, objects
+        )
+    others = sorted(set(record["serialized"]) - set(objects) - set(ACTING_PLACEHOLDERS))
     if others:
         raise ValueError(
             f"{path}: its data record holds pickled {others}, which the suite does not load "
@@ -164,7 +209,7 @@ def infer_sb3_algorithm(path: str | Path) -> type:
 
         return MaskablePPO
     if module == "stable_baselines3.common.policies":
-        algorithm_name = "PPO" if "clip_range" in data else "A2C"
+        algorithm_name = "PPO" if "clip_range" in {*data, *data["serialized"]} else "A2C"
     else:
         algorithm_name = module.split(".")[1].upper() if module.count(".") >= 1 else ""
     algorithm = getattr(sb3, algorithm_name, None)
