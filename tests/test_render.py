@@ -7,14 +7,19 @@ Checked properties:
   PettingZoo env;
 * the system picture (left half of the frame) is drawn and follows the state;
 * a transmission is drawn at the start of its step;
-* ``"human"`` without a display warns once in one line and the episode runs on; a vector env
-  refuses ``"human"`` naming the modes it allows;
+* ``"human"`` shows the frames in a Matplotlib window (the one ``"rgb_array"`` returns), and
+  without a display warns once in one line while the episode runs on; a vector env refuses
+  ``"human"`` naming the modes it allows;
 * the projections the pictures use are rotations, and the asteroid's spacecraft is drawn in the
   inertial frame at the distance it has from the asteroid's centre.
 """
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import textwrap
 import warnings
 
 import gymnasium as gym
@@ -138,6 +143,39 @@ def test_human_mode_without_a_display_warns_once_and_runs():
             vectorization_mode="vector_entry_point",
             render_mode="human",
         )
+
+
+WINDOW_SCRIPT = textwrap.dedent(
+    """
+    import warnings
+    warnings.simplefilter("error")
+    import gymnasium as gym, numpy as np, matplotlib.pyplot as plt
+    import etsc_envs
+    human, twin = (gym.make("etsc/InnerFormation-v0", render_mode=mode, horizon_s=0.05)
+                   for mode in ("human", "rgb_array"))
+    human.reset(seed=0), twin.reset(seed=0)
+    assert len(plt.get_fignums()) == 1
+    for k in range(30):
+        bits = np.array([k % 2, k % 3 == 0, 0])
+        human.step(bits), twin.step(bits)
+    assert human.render() is None
+    shown = np.asarray(plt.figure(plt.get_fignums()[0]).axes[0].images[0].get_array())
+    frame = twin.render()
+    # the strips match exactly; the system's trail holds the frames the window drew, which
+    # depend on the wall clock
+    assert shown.shape == frame.shape and np.array_equal(shown[:, 480:], frame[:, 480:])
+    human.close()
+    assert plt.get_fignums() == []
+    """
+)
+
+
+def test_human_mode_shows_the_rgb_frames_in_a_window():
+    # A backend with windows that needs no display (Matplotlib's template backend, named as a
+    # module so that it counts as interactive).
+    backend = {"MPLBACKEND": "module://matplotlib.backends.backend_template"}
+    subprocess.run([sys.executable, "-c", WINDOW_SCRIPT], env={**os.environ, **backend},
+                   check=True, timeout=300)  # fmt: skip
 
 
 def test_the_views_are_rotations():
