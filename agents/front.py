@@ -155,6 +155,108 @@ def front_verdict(
     }
 
 
+TRANSMISSIONS_AT_EQUAL_COST_MAX = 0.90
+"""A learned point beats the hand-menu front with at most this fraction of the front's
+transmissions at the point's cost..."""
+COST_AT_EQUAL_TRANSMISSIONS_MAX = 0.97
+"""...or at most this fraction of the front's cost at the point's transmissions."""
+
+
+def envelope_transmissions(front: list[tuple[float, float]], cost: float) -> float | None:
+    """The fewest transmissions at which :func:`envelope`'s pairs reach ``cost`` (the inverse
+    of :func:`envelope_cost`, joined alike), ``None`` if no point of the front is as
+    accurate."""
+    if not front or cost < front[-1][1]:
+        return None
+    if cost >= front[0][1]:
+        return front[0][0]
+    for (x0, y0), (x1, y1) in itertools.pairwise(front):
+        if y1 <= cost <= y0:
+            weight = (y0 - cost) / (y0 - y1)
+            return math.exp(math.log(x0) + weight * (math.log(x1) - math.log(x0)))
+    return None
+
+
+def menu_verdict(
+    learned: list[dict[str, Any]],
+    menu: list[dict[str, Any]],
+    bounds: Callable[[dict[str, Any]], tuple[float, float] | None],
+) -> dict[str, Any]:
+    """Does a learned point beat the hand-menu front (the envelope of ``menu``: every hand
+    rule's point, the paper and periodic sweeps included)? Each learned point is read at
+    ``bounds`` (its transmissions and cost at the upper ends of their 95 % intervals on a
+    scenario set; the episode's own values on the paper scenario): it beats the front with at
+    most :data:`TRANSMISSIONS_AT_EQUAL_COST_MAX` × the front's transmissions at its cost, or
+    :data:`COST_AT_EQUAL_TRANSMISSIONS_MAX` × the front's cost at its transmissions. Returns
+    each point's two ratios (``None`` where the front does not reach the point's cost or
+    transmissions), the best of each, and ``met`` (some point beats the front)."""
+    front = envelope([pair for pair in map(bounds_of_means(bounds), menu) if pair is not None])
+    rows = []
+    for point in learned:
+        pair = bounds(point)
+        if pair is None:
+            continue
+        sent, cost = pair
+        front_sent = envelope_transmissions(front, cost)
+        front_cost = envelope_cost(front, sent)
+        rows.append(
+            {
+                "policy": point.get("policy"),
+                "transmissions": sent,
+                "mean_cost": cost,
+                "transmissions_ratio": None if front_sent is None else sent / front_sent,
+                "cost_ratio": None if front_cost is None else _ratio(cost, front_cost),
+            }
+        )
+
+    def best(key: str) -> float | None:
+        values = [row[key] for row in rows if row[key] is not None]
+        return min(values) if values else None
+
+    transmissions, cost = best("transmissions_ratio"), best("cost_ratio")
+    met = (transmissions is not None and transmissions <= TRANSMISSIONS_AT_EQUAL_COST_MAX) or (
+        cost is not None and cost <= COST_AT_EQUAL_TRANSMISSIONS_MAX
+    )
+    return {
+        "points": rows,
+        "best_transmissions_ratio": transmissions,
+        "best_cost_ratio": cost,
+        "met": met,
+    }
+
+
+def bounds_of_means(
+    bounds: Callable[[dict[str, Any]], tuple[float, float] | None],
+) -> Callable[[dict[str, Any]], tuple[float, float] | None]:
+    """The menu's points are read at their means (the envelope the learned point must beat):
+    :func:`set_axes` for the scenario set's bounds, the bounds themselves elsewhere."""
+    return set_axes if bounds is set_upper_bounds else bounds
+
+
+def set_upper_bounds(point: dict[str, Any]) -> tuple[float, float] | None:
+    """(transmissions, mean cost) of a point on the scenario set at the upper ends of their
+    95 % intervals, ``None`` if it failed on any scenario."""
+    if point.get("failures"):
+        return None
+    return float(point["transmissions"]["mean_ci95"][1]), float(point["mean_cost"]["mean_ci95"][1])
+
+
+def menu_line(method: str, where: str, verdict: dict[str, Any]) -> str:
+    """One line saying what :func:`menu_verdict` found."""
+
+    def shown(ratio: float | None) -> str:
+        return "-" if ratio is None else f"x{ratio:.4g}"
+
+    outcome = "**beats it**" if verdict["met"] else "does not beat it"
+    return (
+        f"{method}, {where}: against the hand-menu front, transmissions at equal cost "
+        f"{shown(verdict['best_transmissions_ratio'])} (goal <= "
+        f"{TRANSMISSIONS_AT_EQUAL_COST_MAX}), cost at equal transmissions "
+        f"{shown(verdict['best_cost_ratio'])} (goal <= {COST_AT_EQUAL_TRANSMISSIONS_MAX}); "
+        f"{outcome}"
+    )
+
+
 def verdict_line(method: str, where: str, verdict: dict[str, Any]) -> str:
     """One line saying what :func:`front_verdict` found."""
     low, high = verdict["range"]

@@ -52,9 +52,22 @@ from matplotlib import ticker
 
 import etsc_envs
 from agents.evaluation import episode_summary
-from agents.front import front_verdict, paper_scenario_axes, verdict_line
+from agents.front import (
+    front_verdict,
+    menu_line,
+    menu_verdict,
+    paper_scenario_axes,
+    set_upper_bounds,
+    verdict_line,
+)
 from agents.sweep_results import sweep_models
-from baselines.cli import limit_torch_threads, parse_assignments, require_policies, write_json
+from baselines.cli import (
+    limit_torch_threads,
+    model_spec,
+    parse_assignments,
+    require_policies,
+    write_json,
+)
 from baselines.evaluate import evaluate
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
@@ -191,7 +204,7 @@ def judged_points(
         on_paper = judged["sets"].get("paper")
         for index, row in enumerate(on_set["models"]):
             paper_run = None if on_paper is None else on_paper["models"][index]["learned"]
-            point = point_of(f"sb3:{row['model']}", {}, row["learned"], paper_run)
+            point = point_of(model_spec(row["model"]), {}, row["learned"], paper_run)
             points.append({**point, "method": Path(folder).name})
     return points
 
@@ -237,7 +250,7 @@ def pareto(
                 f"{earlier}, not {identity}"
             )
 
-    require_policies(env_id, env_kwargs, [f"sb3:{path}" for path in models])
+    require_policies(env_id, env_kwargs, [model_spec(path) for path in models])
     read = [
         point
         for folder in judged or []
@@ -259,7 +272,7 @@ def pareto(
             earlier = None if reuse is None else reuse["curves"].get(name)
             curves[name] = earlier or [point(name, args) for args in sweeps[env_id]()]
     curves["learned"] = [
-        {**point(f"sb3:{path}", {}), "method": method}
+        {**point(model_spec(path), {}), "method": method}
         for path, method in zip(models, methods, strict=True)
     ] + read
     result = {
@@ -279,8 +292,12 @@ def front_verdicts(result: dict[str, Any]) -> dict[str, dict[str, Any]]:
     scenario (``paper``, where its points ran there)."""
     curves = result["curves"]
     verdicts: dict[str, dict[str, Any]] = {}
+    menu = hand_menu(result)
     for method, points in learned_methods(result):
         verdicts[method] = {"set": front_verdict(points, curves["paper"], curves["periodic"])}
+        searched = all(str(point.get("policy")).startswith("learned:") for point in points)
+        if searched:
+            verdicts[method]["set_menu"] = menu_verdict(points, menu, set_upper_bounds)
         if all(point.get("paper_scenario") is not None for point in points):
             try:
                 verdicts[method]["paper"] = front_verdict(
@@ -288,7 +305,21 @@ def front_verdicts(result: dict[str, Any]) -> dict[str, dict[str, Any]]:
                 )
             except ValueError:
                 continue
+            if searched:
+                verdicts[method]["paper_menu"] = menu_verdict(points, menu, paper_scenario_axes)
     return verdicts
+
+
+def hand_menu(result: dict[str, Any]) -> list[dict[str, Any]]:
+    """The hand-menu front's points: every point of ``result`` that no search found (the
+    paper's threshold sweep, the periodic sweep, other rules' sweeps and every judged or run
+    model whose policy is not a ``learned:`` trigger: the decision sets' pinned rules)."""
+    return [
+        point
+        for points in result["curves"].values()
+        for point in points
+        if not str(point.get("policy")).startswith("learned:")
+    ]
 
 
 def non_dominated(points: list[dict[str, Any]], cost: Any, sent: Any) -> list[dict[str, Any]]:
@@ -481,7 +512,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("env_id", choices=sorted(PAPER_SWEEPS))
     parser.add_argument(
-        "--model", action="append", default=[], help="an SB3 zip of a learned trigger (repeatable)"
+        "--model",
+        action="append",
+        default=[],
+        help="an SB3 zip or a learned trigger (learned:PATH or .json; repeatable)",
     )
     parser.add_argument("--scenarios", choices=("test", "validation"), default="test")
     parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
@@ -544,8 +578,9 @@ def main(argv: list[str] | None = None) -> int:
             )
     for method, verdicts in result["fronts"].items():
         for where, verdict in verdicts.items():
-            place = "paper scenario" if where == "paper" else f"{args.scenarios} set"
-            print(verdict_line(method, place, verdict))
+            place = "paper scenario" if where.startswith("paper") else f"{args.scenarios} set"
+            line = menu_line if where.endswith("_menu") else verdict_line
+            print(line(method, place, verdict))
     print(f"wrote {out_dir / 'pareto.json'} and {out_dir / 'pareto.png'}")
     return 0
 

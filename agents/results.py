@@ -49,6 +49,7 @@ from agents.sweep_results import finished_trials
 from baselines.cli import (
     episode_setup,
     limit_torch_threads,
+    model_spec,
     parse_assignments,
     require_policies,
     write_json,
@@ -146,14 +147,6 @@ def clock_verdict(
         for key in ("mean_cost", "transmissions")
     )
     return result
-
-
-def model_spec(model: str) -> str:
-    """The ``--policy`` of a ``--model``: as given with a ``sb3:`` or ``learned:`` prefix, a
-    learned trigger for a ``.json`` file, else an SB3 zip."""
-    if model.startswith(("sb3:", "learned:")):
-        return model
-    return f"learned:{model}" if model.endswith(".json") else f"sb3:{model}"
 
 
 def _compare_set(

@@ -15,7 +15,8 @@ The algorithm, in full:
    seeds lie outside the protocol's validation and test ranges) by the env's own return at the
    penalty λ (``transmission_penalty``): ``-Σ cost_k / cost_scale - λ · transmissions``, the
    reward the PPO triggers get, averaged over the batch. CMA-ES is told the negated returns.
-3. Every ``validate_every`` generations the distribution's mean is scored on the first
+3. Every ``validate_every`` generations the distribution's mean (CMA-ES's ``xfavorite``, the
+   mean mapped through the box constraints) is scored on the first
    ``validation_size`` validation scenarios at the full horizon; the learned trigger is the
    validated mean with the best validation return (the start point, validated at generation
    0, competes too). The test set is never touched here.
@@ -367,6 +368,7 @@ def run_search(
     }
     es = cma.CMAEvolutionStrategy(space.encode(start).tolist(), config.sigma, options)
 
+    out.mkdir(parents=True, exist_ok=True)
     log_path = out / "generations.jsonl"
     history = (
         [json.loads(line) for line in log_path.read_text().splitlines()]
@@ -394,7 +396,7 @@ def run_search(
             (config.env_id, training_args, _learned(config, p, {}).to_json(), seeds) for p in points
         ]
         validate = generation % config.validate_every == 0 or generation == config.generations - 1
-        mean_point = start if generation == 0 else space.decode(es.mean)
+        mean_point = start if generation == 0 else space.decode(es.result.xfavorite)
         if validate:
             calls.append(
                 (

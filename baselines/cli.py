@@ -319,6 +319,14 @@ def _policy_for(
     raise ValueError(f"--policy must be one of {POLICY_CHOICES}, got {spec!r}")
 
 
+def model_spec(model: str) -> str:
+    """The ``--policy`` of a ``--model``: as given with a ``sb3:`` or ``learned:`` prefix, a
+    learned trigger for a ``.json`` file, else an SB3 zip."""
+    if model.startswith(("sb3:", "learned:")):
+        return model
+    return f"learned:{model}" if model.endswith(".json") else f"sb3:{model}"
+
+
 def write_json(payload: dict[str, Any], destination: str) -> None:
     """Write ``payload`` as JSON to a file (whole or not at all), or to standard output for
     ``-``."""

@@ -10,8 +10,11 @@ import pytest
 from agents.front import (
     envelope,
     envelope_cost,
+    envelope_transmissions,
     front_verdict,
+    menu_verdict,
     paper_scenario_axes,
+    set_upper_bounds,
     verdict_line,
 )
 from agents.pareto import front_verdicts
@@ -115,3 +118,62 @@ def test_pareto_judges_every_learned_method_on_the_set_and_the_paper_scenario():
     verdicts = front_verdicts(result)
     assert verdicts["front"]["set"]["met"] and verdicts["front"]["paper"]["met"]
     assert "paper" not in verdicts["single"] and not verdicts["single"]["set"]["met"]
+
+
+def bounded(sent: float, cost: float, spread: float = 0.0, policy: str = "paper") -> dict:
+    """A point with 95 % intervals of ``± spread`` (relative) on both axes."""
+    return {
+        "policy": policy,
+        "transmissions": {"mean": sent, "mean_ci95": [sent * (1 - spread), sent * (1 + spread)]},
+        "mean_cost": {"mean": cost, "mean_ci95": [cost * (1 - spread), cost * (1 + spread)]},
+        "failures": 0,
+        "paper_scenario": {"transmissions": sent, "mean_cost": cost, "failure": None},
+    }
+
+
+MENU = [bounded(100, 4.0), bounded(400, 2.0), bounded(1600, 1.0)]
+
+
+def test_the_inverse_envelope_joins_in_log_transmissions():
+    front = envelope([(100, 4.0), (400, 2.0)])
+    assert envelope_transmissions(front, 3.0) == pytest.approx(200.0)
+    assert envelope_transmissions(front, 5.0) == 100
+    assert envelope_transmissions(front, 1.0) is None  # the menu never gets that accurate
+
+
+def test_a_learned_point_beats_the_menu_by_transmissions_or_by_cost():
+    fewer = menu_verdict([bounded(170, 3.0, policy="learned:x")], MENU, set_upper_bounds)
+    assert fewer["best_transmissions_ratio"] == pytest.approx(170 / 200)
+    assert fewer["met"]
+    cheaper = menu_verdict([bounded(400, 1.9, policy="learned:x")], MENU, set_upper_bounds)
+    assert cheaper["best_cost_ratio"] == pytest.approx(0.95) and cheaper["met"]
+    level = menu_verdict([bounded(400, 2.0, policy="learned:x")], MENU, set_upper_bounds)
+    assert not level["met"]
+
+
+def test_the_menu_verdict_reads_the_learned_point_at_its_intervals_upper_bound():
+    inside = bounded(170, 3.0, spread=0.0, policy="learned:x")
+    wide = bounded(170, 3.0, spread=0.2, policy="learned:x")  # 204 transmissions at 3.6
+    assert menu_verdict([inside], MENU, set_upper_bounds)["met"]
+    assert not menu_verdict([wide], MENU, set_upper_bounds)["met"]
+
+
+def test_pareto_judges_searched_methods_against_every_hand_point():
+    result = {
+        "curves": {
+            "paper": MENU[:2],
+            "periodic": [bounded(1600, 1.0, policy="periodic")],
+            "learned": [
+                {**bounded(170, 3.0, policy="learned:a.json"), "method": "search"},
+                {**bounded(100, 3.5, policy="sb3:pinned.zip"), "method": "pinned"},
+            ],
+        }
+    }
+    verdicts = front_verdicts(result)
+    assert "set_menu" not in verdicts["pinned"]
+    # the pinned rule is a hand point: the search's 170 at 3.0 is not below its envelope
+    assert not verdicts["search"]["set_menu"]["met"]
+    assert verdicts["search"]["set_menu"]["best_transmissions_ratio"] > 0.9
+    result["curves"]["learned"].pop()
+    verdicts = front_verdicts(result)
+    assert verdicts["search"]["set_menu"]["met"] and verdicts["search"]["paper_menu"]["met"]
