@@ -11,7 +11,8 @@ Checked properties:
   without a display warns once in one line while the episode runs on; a vector env refuses
   ``"human"`` naming the modes it allows;
 * the projections the pictures use are rotations, and the asteroid's spacecraft is drawn in the
-  inertial frame at the distance it has from the asteroid's centre.
+  inertial frame at the distance it has from the asteroid's centre, with the radius's extremes
+  of the episode.
 """
 
 from __future__ import annotations
@@ -191,10 +192,13 @@ def test_the_spacecraft_is_drawn_where_it_is():
     env.reset(seed=0)
     for _ in range(800):
         env.step(0)
-    time_s, *position, firing = asteroid_snapshot(env)
+    time_s, *position, firing, lowest, highest = asteroid_snapshot(env)
     state = env.state_dict()
+    metrics = env.episode_metrics()
     assert time_s == env.time_s and firing == 0.0
     assert np.linalg.norm(position) == pytest.approx(float(state["radius_m"]), rel=1e-12)
+    assert (lowest, highest) == (metrics["min_radius_m"], metrics["max_radius_m"])
+    assert lowest <= float(state["radius_m"]) <= highest
     spin = env.model.spin_rate * time_s  # I from A: turned back by ω_T t about z
     assert position[2] == pytest.approx(float(state["position_m"][2]))
     azimuth_a = np.arctan2(state["position_m"][1], state["position_m"][0])

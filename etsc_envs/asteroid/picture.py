@@ -7,9 +7,10 @@ by the Sun; the safe shell r_0 ± ``shell_half_width_m`` that paper 003's barrie
 keeps the orbit in (green), the reference circle r_0 (dashed) and the operating region's
 bounds (dotted); the spacecraft's trail through the episode's frames and the spacecraft
 (an orange star while a thrust burst of eqs. (16)-(17) fires). Below, ‖r‖ - r_0 over the
-episode against the shell, where a 5-m band on a 200-m orbit becomes visible: one dot per
-frame (the radius oscillates between bursts faster than frames are usually drawn, so the dots
-are samples, not a curve).
+episode against the shell, where a 5-m band on a 200-m orbit becomes visible: its value now
+(a dot) and the least and greatest it has been since the reset (lines, from every sampling
+period of the loop; the radius oscillates between bursts faster than frames are usually
+drawn, so the frames' own values would alias).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from matplotlib.figure import Figure
 from matplotlib.gridspec import SubplotSpec
 from matplotlib.patches import Annulus, Circle
 
-from etsc_envs.asteroid.closed_loop import PLANT
+from etsc_envs.asteroid.closed_loop import MAX_RADIUS, MIN_RADIUS, PLANT
 from etsc_envs.asteroid.dynamics import R, inertial_to_asteroid
 from etsc_envs.core.render import SystemPicture, bare_axes
 
@@ -31,10 +32,13 @@ BURST_COLOR = "#ff7f0e"
 
 
 def snapshot(env: Any) -> np.ndarray:
-    """``[t, r in I (3), burst firing (0/1)]`` at the current instant."""
+    """``[t, r in I (3), burst firing (0/1), least ‖r‖, greatest ‖r‖]`` at the current
+    instant (the extremes since the reset)."""
     t = env.time_s
-    position = inertial_to_asteroid(t, env.model.spin_rate).T @ env.state[PLANT][R]
-    return np.array([t, *position, float(env.burst_active())])
+    state = env.state
+    position = inertial_to_asteroid(t, env.model.spin_rate).T @ state[PLANT][R]
+    extremes = (state[MIN_RADIUS], state[MAX_RADIUS])
+    return np.array([t, *position, float(env.burst_active()), *extremes])
 
 
 def orbit_view(azimuth_deg: float) -> np.ndarray:
@@ -71,13 +75,17 @@ def draw(env: Any, figure: Figure, region: SubplotSpec, trail: np.ndarray) -> No
     axes.set_title("asteroid, orbit and safe shell (orbit plane, inertial)", fontsize=8)
 
     strip = figure.add_subplot(radius_cell)
-    error = np.linalg.norm(trail[:, 1:4], axis=1) - r0
+    error = float(np.linalg.norm(trail[-1, 1:4])) - r0
+    lowest, highest = trail[:, 5] - r0, trail[:, 6] - r0
     strip.axhspan(-half, half, color=SHELL_COLOR, alpha=0.3, lw=0)
-    strip.plot(trail[:, 0], error, "o", color="black", markersize=2.0)
-    reach = max(1.6 * half, 1.1 * float(np.abs(error).max()))
+    for extreme in (lowest, highest):
+        strip.step(trail[:, 0], extreme, where="post", color="black", linewidth=0.8)
+    strip.plot(trail[-1, 0], error, "o", color="black", markersize=4)
+    reach = max(1.6 * half, 1.1 * float(max(-lowest.min(), highest.max())))
     strip.set_ylim(-reach, reach)
     strip.set_xlim(0.0, env.horizon_s)
     strip.set_ylabel("|r| - r0 (m)", fontsize=7)
+    strip.set_title("now (dot), least and greatest so far (lines)", fontsize=7)
     strip.tick_params(labelsize=7)
 
 
