@@ -2,11 +2,16 @@
 simulated instants and wall-clock time.
 
     python -m agents.learning_curves --run LABEL=RUN_DIR [--run LABEL=RUN_DIR ...]
+                                     [--include LEARNING_CURVES_JSON ...]
                                      [--cost-tolerance 1.05] [--out DIR]
 
 Each ``RUN_DIR`` is the output folder of ``python -m agents.train`` (its ``evaluations.json``:
 the policy and the paper trigger on the validation scenarios, with the sampling instants
-simulated for training so far and the training wall time at every evaluation). Runs with the
+simulated for training so far and the training wall time at every evaluation) or of
+``python -m agents.search`` (its ``generations.jsonl``: the validated mean of the evolution
+strategy, against the paper trigger run once on the same validation scenarios).
+``--include LEARNING_CURVES_JSON`` keeps the methods of an earlier result (runs whose folders
+are no longer at hand) beside the new runs. Runs with the
 same ``LABEL`` (one method, several training seeds) are drawn in one colour and summarised
 together.
 
@@ -40,6 +45,10 @@ DEFAULT_COST_TOLERANCE = 1.05
 """The goal's cost tolerance: within 5 % of the paper trigger's ``mean_cost``."""
 
 
+RUN_RECORDS = ("evaluations.json", "generations.jsonl")
+"""A training run's validation record (``agents.train``) or a search's (``agents.search``)."""
+
+
 def parse_runs(specs: list[str]) -> list[tuple[str, Path]]:
     """``LABEL=RUN_DIR`` pairs, each folder holding an ``evaluations.json``."""
     runs = []
@@ -47,18 +56,53 @@ def parse_runs(specs: list[str]) -> list[tuple[str, Path]]:
         label, separator, folder = spec.partition("=")
         if not separator or not label or not folder:
             raise ValueError(f"--run must be LABEL=RUN_DIR, got {spec!r}")
-        path = Path(folder) / "evaluations.json"
-        if not path.is_file():
-            raise ValueError(f"--run {spec}: no evaluations.json in {folder}")
+        if not any((Path(folder) / name).is_file() for name in RUN_RECORDS):
+            raise ValueError(f"--run {spec}: no {' or '.join(RUN_RECORDS)} in {folder}")
         runs.append((label, Path(folder)))
     if not runs:
         raise ValueError("--run: give at least one LABEL=RUN_DIR")
     return runs
 
 
+def search_evaluations(folder: Path) -> list[dict[str, Any]]:
+    """A search's validation curve (``python -m agents.search``: the validated mean of each
+    validating generation in ``generations.jsonl``) in the form of a training run's
+    ``evaluations.json``, the paper trigger evaluated once on the same validation scenarios
+    (those of the search's ``config.yaml``) as the reference."""
+    from agents.search import load_config
+    from baselines.evaluate import evaluate
+
+    config = load_config(folder / "config.yaml")
+    paper = evaluate(
+        config.env_id,
+        "paper",
+        env_args=config.env_args(training=False),
+        scenarios="validation",
+        set_size=config.validation_size,
+    )["mean"]
+    paper = {**paper, "failures": 0}
+    evaluations = []
+    for line in (folder / "generations.jsonl").read_text(encoding="utf-8").splitlines():
+        record = json.loads(line)
+        if "validation" in record:
+            evaluations.append(
+                {
+                    "timesteps": record["env_steps"],
+                    "env_steps": record["env_steps"],
+                    "wall_time_s": record["wall_s"],
+                    "learned": record["validation"],
+                    "paper": paper,
+                }
+            )
+    return evaluations
+
+
 def run_curve(folder: Path, cost_tolerance: float) -> dict[str, Any]:
     """One run's validation curve relative to the paper trigger, and where it reached it."""
-    evaluations = json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
+    if (folder / "generations.jsonl").is_file():
+        evaluations = search_evaluations(folder)
+    else:
+        evaluations = json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
     missing = [entry["timesteps"] for entry in evaluations if "env_steps" not in entry]
     if missing:
         raise ValueError(
@@ -102,15 +146,29 @@ def _spread(values: list[float]) -> dict[str, Any]:
     return {"median": float(np.median(values)), "range": [min(values), max(values)]}
 
 
-def learning_curves(runs: list[tuple[str, Path]], cost_tolerance: float) -> dict[str, Any]:
+def learning_curves(
+    runs: list[tuple[str, Path]],
+    cost_tolerance: float,
+    earlier: list[dict[str, Any]] | None = None,
+) -> dict[str, Any]:
     """Every run's curve, grouped by label, with the per-label summary of the module
-    docstring."""
+    docstring; the methods of ``earlier`` results (``learning_curves.json`` of runs whose
+    folders are gone) are kept beside them."""
     if not cost_tolerance >= 1.0:
         raise ValueError(f"--cost-tolerance must be at least 1, got {cost_tolerance!r}")
     methods: dict[str, dict[str, Any]] = {}
+    for result in earlier or []:
+        if result.get("cost_tolerance") != cost_tolerance:
+            raise ValueError(
+                f"--include: that result used cost tolerance {result.get('cost_tolerance')}, "
+                f"not {cost_tolerance}"
+            )
+        methods.update(result["methods"])
     for label, folder in runs:
         methods.setdefault(label, {"runs": []})["runs"].append(run_curve(folder, cost_tolerance))
     for method in methods.values():
+        if "reached" in method:
+            continue
         reached = [run for run in method["runs"] if run["reached_at_env_steps"] is not None]
         method["reached"] = f"{len(reached)}/{len(method['runs'])}"
         method["env_steps_to_reach"] = _spread([run["reached_at_env_steps"] for run in reached])
@@ -160,13 +218,23 @@ def main(argv: list[str] | None = None) -> int:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--run", action="append", default=[], metavar="LABEL=RUN_DIR")
+    parser.add_argument(
+        "--include",
+        action="append",
+        default=[],
+        type=Path,
+        metavar="LEARNING_CURVES_JSON",
+        help="keep the methods of an earlier result beside the runs (repeatable)",
+    )
     parser.add_argument("--cost-tolerance", type=float, default=DEFAULT_COST_TOLERANCE)
     parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
     args = parser.parse_args(argv)
     out_dir = args.out or Path("results") / "learning_curves"
     try:
         require_writable_folder(out_dir, "--out")
-        result = learning_curves(parse_runs(args.run), args.cost_tolerance)
+        earlier = [json.loads(path.read_text(encoding="utf-8")) for path in args.include]
+        runs = parse_runs(args.run) if args.run or not earlier else []
+        result = learning_curves(runs, args.cost_tolerance, earlier)
     except (ValueError, OSError, KeyError) as error:
         parser.error(str(error))
     write_json(result, str(out_dir / "learning_curves.json"))

@@ -73,3 +73,49 @@ def test_a_run_without_instants_is_refused(tmp_path: Path, capsys) -> None:
     with pytest.raises(SystemExit):
         main(["--run", f"old={folder}", "--out", str(tmp_path / "out")])
     assert "env_steps" in capsys.readouterr().err
+
+
+def test_a_search_is_a_run_against_the_paper_trigger_on_its_validation_scenarios(
+    tmp_path: Path,
+) -> None:
+    """An agents.search folder's validated means are read against the paper trigger, which
+    is run on the search's own validation scenarios; earlier results join with --include."""
+    from baselines.evaluate import evaluate
+
+    folder = tmp_path / "search"
+    folder.mkdir()
+    (folder / "config.yaml").write_text(
+        "env_id: etsc/InnerFormation-v0\npenalty: 5.0\nsearch: [factors]\ngenerations: 2\n"
+        "population: 2\nscenarios: 1\nvalidation_size: 2\n"
+    )
+    paper = evaluate(
+        "etsc/InnerFormation-v0",
+        "paper",
+        env_args={"transmission_penalty": 5.0},
+        scenarios="validation",
+        set_size=2,
+    )["mean"]
+    records = [
+        {"generation": 0, "env_steps": 100, "wall_s": 1.0, "returns": [0.0]},
+        {
+            "generation": 1,
+            "env_steps": 200,
+            "wall_s": 2.0,
+            "returns": [0.0],
+            "validation": {
+                "mean_cost": paper["mean_cost"] * 1.01,
+                "transmissions": paper["transmissions"] * 0.5,
+                "failures": 0,
+            },
+        },
+    ]
+    (folder / "generations.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    earlier = learning_curves(
+        parse_runs([f"ppo={_run(tmp_path / 'ppo', [(2.0, 50, 0)], 1)}"]), 1.05
+    )
+    result = learning_curves(parse_runs([f"es={folder}"]), 1.05, [earlier])
+    assert set(result["methods"]) == {"ppo", "es"}
+    (run,) = result["methods"]["es"]["runs"]
+    assert run["reached_at_env_steps"] == 200
+    assert run["points"][0]["cost_ratio"] == pytest.approx(1.01)
+    assert result["methods"]["ppo"]["reached"] == "0/1"
