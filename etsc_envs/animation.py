@@ -35,7 +35,7 @@ from etsc_envs.triggers import PAPER_TRIGGERS
 
 GIF_DIR = Path("docs/envs")
 """Where the command writes, relative to the working directory (the checkout's root)."""
-FRAMES = 80
+FRAMES = 100
 """Frames after the first of a GIF the command writes."""
 WARP = 2.0
 GIF_WIDTH_PX = 720
@@ -134,7 +134,7 @@ def write_gif(
     sheet = Image.new("RGB", (width, height * len(samples)))
     for row, image in enumerate(samples):
         sheet.paste(image, (0, row * height))
-    palette = sheet.quantize(COLORS, method=Image.Quantize.MEDIANCUT)
+    palette = sheet.quantize(COLORS, method=Image.Quantize.MAXCOVERAGE)
     images = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in scaled]
     period_ms = round(1000.0 / fps)
     durations = [period_ms] * (len(images) - 1) + [round(1000.0 * FINAL_HOLD_S)]
