@@ -150,12 +150,17 @@ def step_count(horizon_s: float, sampling_period_s: float) -> int:
     number of sampling periods (within a relative 1e-9, for decimal fractions)."""
     periods = horizon_s / sampling_period_s
     count = round(periods)
-    if count < 1 or abs(periods - count) > 1e-9 * periods:
+    if not 1 <= count <= MAX_STEPS or abs(periods - count) > 1e-9 * periods:
         raise ValueError(
-            f"horizon_s must be a whole number (>= 1) of sampling periods "
-            f"({sampling_period_s} s), got {horizon_s} s = {periods:.6g} periods"
+            f"horizon_s must be a whole number of sampling periods ({sampling_period_s} s), "
+            f"from 1 to {MAX_STEPS:.0e}, got {horizon_s} s = {periods:.6g} periods"
         )
     return count
+
+
+MAX_STEPS = 10**12
+"""The most sampling instants an episode may have: step counters are 64-bit integers in the
+compiled loop (and a longer episode would not end in any time anyone waits for)."""
 
 
 def require_reset_options(options: Any, allowed: Iterable[str] = ()) -> dict[str, Any]:
