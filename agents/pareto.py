@@ -5,7 +5,7 @@ under the test protocol.
                                    [--judged RESULTS_DIR ...]
                                    [--scenarios test|validation] [--set-size K]
                                    [--env-arg k=v ...] [--out DIR]
-                                   [--reuse PARETO_JSON]
+                                   [--reuse PARETO_JSON] [--menu PARETO_JSON ...]
 
 Every point of three curves runs on a scenario set of the protocol (default the test set, all
 its scenarios at once in the native vector env) and on the paper scenario:
@@ -31,6 +31,11 @@ A point records the set's aggregates (mean ``mean_cost`` and transmissions with 
 intervals, failures) and the paper scenario's episode. The plot shows each curve's
 non-dominated points joined, with interval bars on both axes, dominated points faint, points
 with failures crossed, and the paper scenario in a second panel.
+
+A method of ``learned:`` triggers (a search's) is also judged against the **hand-menu front**,
+the envelope of every point that no search found: the sweeps, every other model, and every
+point of each ``--menu`` result (earlier fronts: the pinned rule variants of the decision sets,
+the headlines among them), drawn as a curve of its own (:func:`agents.front.menu_verdict`).
 
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
 ``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper, periodic (and other
@@ -225,12 +230,15 @@ def pareto(
     reuse: dict[str, Any] | None = None,
     methods: list[str] | None = None,
     judged: list[Path] | None = None,
+    menu: list[dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """The three curves of the module docstring for ``env_id``; with ``reuse`` (an earlier
     result of the same id, kwargs and scenario set), its paper and periodic curves are kept and
     only the models run. ``methods`` names each model's method (the plot draws each method as
     its own curve; default one method, ``learned``); the models judged under each folder of
-    ``judged`` join the learned points without running (:func:`judged_points`)."""
+    ``judged`` join the learned points without running (:func:`judged_points`); every point
+    of each earlier result of ``menu`` (same closed loop, kwargs and scenario set) joins the
+    ``hand_menu`` curve, the hand-menu front a search is judged against (:func:`hand_menu`)."""
     methods = list(methods) if methods is not None else [LEARNED] * len(models)
     if len(methods) != len(models):
         raise ValueError(f"methods: one per model ({len(models)}), got {len(methods)}")
@@ -239,16 +247,17 @@ def pareto(
     if scenarios not in ("test", "validation"):
         raise ValueError(f"--scenarios must be 'test' or 'validation', got {scenarios!r}")
     identity = (closed_loop_id(env_id), env_kwargs, scenarios, set_size)
-    if reuse is not None:
-        earlier = (
-            closed_loop_id(str(reuse.get("env"))),
-            *(reuse.get(key) for key in ("env_kwargs", "scenarios", "set_size")),
-        )
-        if earlier != identity:
-            raise ValueError(
-                f"--reuse: that result is of (closed loop, env_kwargs, scenarios, set_size) = "
-                f"{earlier}, not {identity}"
+    for option, results in (("--reuse", [] if reuse is None else [reuse]), ("--menu", menu)):
+        for earlier_result in results or []:
+            earlier = (
+                closed_loop_id(str(earlier_result.get("env"))),
+                *(earlier_result.get(key) for key in ("env_kwargs", "scenarios", "set_size")),
             )
+            if earlier != identity:
+                raise ValueError(
+                    f"{option}: that result is of (closed loop, env_kwargs, scenarios, "
+                    f"set_size) = {earlier}, not {identity}"
+                )
 
     require_policies(env_id, env_kwargs, [model_spec(path) for path in models])
     read = [
@@ -271,6 +280,13 @@ def pareto(
         if env_id in sweeps:
             earlier = None if reuse is None else reuse["curves"].get(name)
             curves[name] = earlier or [point(name, args) for args in sweeps[env_id]()]
+    if menu:
+        curves["hand_menu"] = [
+            point
+            for earlier_result in menu
+            for curve in earlier_result["curves"].values()
+            for point in curve
+        ]
     curves["learned"] = [
         {**point(model_spec(path), {}), "method": method}
         for path, method in zip(models, methods, strict=True)
@@ -340,6 +356,7 @@ STYLES = {
     "paper": ("o", "-", "C0", "paper trigger (threshold sweep)"),
     "periodic": ("s", "--", "C1", "periodic (clock)"),
     "error_time": ("P", "-.", "C8", "error-time rule (threshold sweep)"),
+    "hand_menu": ("h", "-", "C7", "hand menu (every earlier trigger's point)"),
 }
 LEARNED_STYLES = [("*", ":", "C3"), ("D", ":", "C2"), ("^", ":", "C4"), ("v", ":", "C5")]
 """Marker, line and colour of each learned method in turn."""
@@ -535,6 +552,14 @@ def main(argv: list[str] | None = None) -> int:
         help="add the models judged by agents.results under a folder, read from their "
         "records without running them again (repeatable)",
     )
+    parser.add_argument(
+        "--menu",
+        action="append",
+        default=[],
+        type=Path,
+        metavar="PARETO_JSON",
+        help="every point of an earlier result joins the hand-menu front (repeatable)",
+    )
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="env keyword")
     parser.add_argument("--out", type=output_folder_argument("--out"), help="output folder")
     parser.add_argument(
@@ -564,6 +589,7 @@ def main(argv: list[str] | None = None) -> int:
             reuse,
             methods,
             args.judged,
+            [json.loads(path.read_text(encoding="utf-8")) for path in args.menu],
         )
     except (ValueError, TypeError, OSError, gym.error.Error) as error:
         parser.error(str(error))
