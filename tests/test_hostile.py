@@ -1238,3 +1238,17 @@ def test_property_a_command_line_value_is_refused_with_one_line_naming_it(
         assert option in line or key in line, line
     else:
         assert status == 0
+
+
+@pytest.mark.parametrize("mode", [3, 2.5, ["human"]])
+def test_a_render_mode_that_is_not_a_string_is_refused_through_gym_make(mode) -> None:
+    """gym.make tests the mode against the metadata and calls string methods on it before the
+    env's constructor runs; the metadata's render_modes refuse it with one line."""
+    import gymnasium as gym
+
+    import etsc_envs
+
+    with pytest.raises(ValueError, match="render_mode must be one of"):
+        gym.make("etsc/AttitudeTracking-v0", render_mode=mode)
+    with pytest.raises(ValueError, match="render_mode must be one of"):
+        etsc_envs.make_parallel("etsc/ClusterContainment-v0", render_mode=mode)

@@ -15,7 +15,7 @@ from etsc_envs.cluster.env import ClusterContainmentCentralEnv
 from etsc_envs.cluster.params import ClusterContainmentParams
 from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.multi_agent import EventTriggeredParallelEnv
-from etsc_envs.core.render import RENDER_MODES
+from etsc_envs.core.render import RENDER_MODES, RenderModes
 
 
 @document_keywords(ClusterContainmentParams)
@@ -34,7 +34,7 @@ class ClusterContainmentEnv(EventTriggeredParallelEnv):
 
     metadata: ClassVar[dict[str, Any]] = {
         "name": "cluster_containment_v0",
-        "render_modes": list(RENDER_MODES),
+        "render_modes": RenderModes(RENDER_MODES),
         "render_fps": 10,
         "is_parallelizable": True,
     }

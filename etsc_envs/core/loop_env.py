@@ -50,6 +50,7 @@ from etsc_envs.core.render import (
     RENDER_MODES,
     EpisodeTrace,
     HumanWindow,
+    RenderModes,
     SystemPicture,
     draw_frame,
 )
@@ -103,7 +104,7 @@ class EventTriggeredEnv(gym.Env):
     """
 
     metadata: ClassVar[dict[str, Any]] = {
-        "render_modes": list(RENDER_MODES),
+        "render_modes": RenderModes(RENDER_MODES),
         "render_fps": RENDER_FPS,
     }
     kernels: ClassVar[ProblemKernels]

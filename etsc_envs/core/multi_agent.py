@@ -34,7 +34,7 @@ from pettingzoo import ParallelEnv
 from etsc_envs.core.compiled_loop import LoopArrays
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.metrics import interevent_summary
-from etsc_envs.core.render import RENDER_MODES
+from etsc_envs.core.render import RENDER_MODES, RenderModes
 from etsc_envs.core.validation import require_reset_options
 
 CLOCK_NAME = "time_since_transmission_s"
@@ -103,7 +103,7 @@ class EventTriggeredParallelEnv(ParallelEnv):
 
     metadata: ClassVar[dict[str, Any]] = {
         "name": "event_triggered_parallel_v0",
-        "render_modes": list(RENDER_MODES),
+        "render_modes": RenderModes(RENDER_MODES),
         "render_fps": 10,
         "is_parallelizable": True,
     }

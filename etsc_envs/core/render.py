@@ -34,6 +34,19 @@ from matplotlib.ticker import LogFormatter
 
 RENDER_MODES = ("rgb_array", "human")
 """The render modes every environment of the suite accepts (besides ``None``)."""
+
+
+class RenderModes(list):
+    """An env's ``metadata["render_modes"]``: a list whose membership test refuses a mode that
+    is not a string with one line naming ``render_mode`` (``gym.make`` tests membership, then
+    calls string methods on the mode, before the env's own check runs)."""
+
+    def __contains__(self, mode: object) -> bool:
+        if mode is not None and not isinstance(mode, str):
+            raise ValueError(f"render_mode must be one of {tuple(self)} or None, got {mode!r}")
+        return super().__contains__(mode)
+
+
 RENDER_FPS = 10
 """Frames per second of ``"human"`` mode (wall-clock) and of the GIFs made from the frames."""
 
