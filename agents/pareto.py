@@ -62,7 +62,7 @@ from agents.front import (
     menu_line,
     menu_verdict,
     paper_scenario_axes,
-    set_upper_bounds,
+    set_axes,
     verdict_line,
 )
 from agents.sweep_results import sweep_models
@@ -313,7 +313,7 @@ def front_verdicts(result: dict[str, Any]) -> dict[str, dict[str, Any]]:
         verdicts[method] = {"set": front_verdict(points, curves["paper"], curves["periodic"])}
         searched = all(str(point.get("policy")).startswith("learned:") for point in points)
         if searched:
-            verdicts[method]["set_menu"] = menu_verdict(points, menu, set_upper_bounds)
+            verdicts[method]["set_menu"] = menu_verdict(points, menu, set_axes)
         if all(point.get("paper_scenario") is not None for point in points):
             try:
                 verdicts[method]["paper"] = front_verdict(
