@@ -13,6 +13,7 @@ import numpy as np
 from tqdm import tqdm
 
 import etsc_envs  # noqa: F401  (registers the environment ids)
+from baselines.progress import JobBar, current_job
 
 
 def window_edges(edges_s: Sequence[float]) -> tuple[float, ...]:
@@ -80,9 +81,13 @@ class EpisodeTrace:
         return np.array([sample[name] for sample in self.samples])
 
 
-def instants_bar(total: int | None, progress: bool, description: str) -> tqdm:
+def instants_bar(total: int | None, progress: bool, description: str) -> tqdm | JobBar:
     """A progress bar over ``total`` sampling instants (hidden unless ``progress``), for one
-    episode here and for a batch of them in :mod:`baselines.batch`."""
+    episode here and for a batch of them in :mod:`baselines.batch`; inside an open
+    :class:`~baselines.progress.JobProgress`, the job's own bar counts the instants instead."""
+    job = current_job()
+    if job is not None:
+        return JobBar(job)
     return tqdm(
         total=total,
         disable=not progress,

@@ -3,7 +3,10 @@
     python -m baselines.reproduce [--paper NNN ...] [--json PATH|-] [--plot DIR]
 
 Prints, for every metric a paper reports, the paper's value beside the suite's, then checks the
-paper's qualitative claims. Without ``--paper`` every available reproduction runs.
+paper's qualitative claims. Without ``--paper`` every available reproduction runs. What runs
+now, the share of the planned sampling instants done and an estimate of the time left go to
+standard error (:mod:`baselines.progress`): a bar on a terminal, a line at each run and every
+20 s when redirected.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ import sys
 from pathlib import Path
 
 from baselines.cli import write_json
+from baselines.progress import JobProgress
 from baselines.reproductions import REPRODUCTIONS
 from baselines.reproductions.report import render
 from etsc_envs.core.files import output_file_argument, output_folder_argument
@@ -49,15 +53,27 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     papers = args.paper or sorted(REPRODUCTIONS)
+    print(
+        f"Reproducing paper{'s' if len(papers) > 1 else ''} {', '.join(papers)}: planning the "
+        "runs (each id's first step loads its compiled kernels, or compiles them where "
+        "`python -m etsc_envs.compile` has not run)",
+        file=sys.stderr,
+        flush=True,
+    )
+    plans = {paper: REPRODUCTIONS[paper].planned_instants() for paper in papers}
     results = []
-    for paper in papers:
-        module = REPRODUCTIONS[paper]
-        plot_dir = Path(args.plot) / f"paper_{paper}" if args.plot else None
-        result = module.reproduce(plot_dir=plot_dir, progress=sys.stderr.isatty())
-        results.append(result)
-        if args.json != "-":
-            print(render(result), flush=True)
-            print()
+    with JobProgress(sum(plans.values())) as job:
+        planned = 0
+        for paper in papers:
+            module = REPRODUCTIONS[paper]
+            job.stage(f"paper {paper}: {module.TITLE}")
+            plot_dir = Path(args.plot) / f"paper_{paper}" if args.plot else None
+            result = module.reproduce(plot_dir=plot_dir)
+            planned += plans[paper]
+            job.reach(planned)
+            results.append(result)
+            if args.json != "-":
+                job.write(render(result) + "\n")
     if args.json:
         write_json({"reproductions": results}, args.json)
     failing = {r["paper"]: sum(not item["holds"] for item in r.get("claims", [])) for r in results}

@@ -21,7 +21,13 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
+from baselines.reproductions.report import (
+    Scenario,
+    claim,
+    metric_row,
+    run_scenarios,
+    scenario_instants,
+)
 from etsc_envs.triggers.asteroid import PAPER_ALPHA
 
 PAPER = "003"
@@ -346,6 +352,11 @@ def _figures(records: dict, traces: dict, plot_dir: Path) -> list[str]:
         written.append(_figure_attitude(traces, signal, unit, path, f"{name} (Fig. {number})"))
     env.close()
     return [str(path) for path in written]
+
+
+def planned_instants() -> int:
+    """The sampling instants of the runs :func:`reproduce` makes (its progress's plan)."""
+    return scenario_instants(ENV_ID, SCENARIOS)
 
 
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:

@@ -15,7 +15,13 @@ import numpy as np
 
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
+from baselines.reproductions.report import (
+    Scenario,
+    claim,
+    metric_row,
+    run_scenarios,
+    scenario_instants,
+)
 
 PAPER = "002"
 TITLE = "Event-triggered attitude tracking for rigid spacecraft (Cai et al. 2019)"
@@ -202,9 +208,19 @@ def _figures(traces: dict[Scenario, EpisodeTrace], plot_dir: Path) -> list[str]:
     return [str(path) for path in written]
 
 
+def _scenarios() -> list[Scenario]:
+    """Every scenario of Tables 1-3, once each, in table order."""
+    return list(dict.fromkeys(row[0] for rows in TABLES.values() for row in rows))
+
+
+def planned_instants() -> int:
+    """The sampling instants of the runs :func:`reproduce` makes (its progress's plan)."""
+    return scenario_instants(ENV_ID, _scenarios())
+
+
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run every scenario of Tables 1-3 once and compare with the paper's numbers."""
-    scenarios = list(dict.fromkeys(row[0] for rows in TABLES.values() for row in rows))
+    scenarios = _scenarios()
     sampled = FIGURE_RUNS if plot_dir is not None else ()
     records, traces = run_scenarios(ENV_ID, scenarios, sampled, SAMPLE_EVERY, f"paper {PAPER}")
     tables = [

@@ -22,7 +22,13 @@ import etsc_envs
 from baselines.cli import make_agent_policy
 from baselines.episodes import EpisodeTrace, run_parallel_episode
 from baselines.reproductions.cluster_figures import draw_figures
-from baselines.reproductions.report import Scenario, claim, metric_row, stages
+from baselines.reproductions.report import (
+    Scenario,
+    claim,
+    metric_row,
+    scenario_instants,
+    stages,
+)
 from etsc_envs.cluster.env import hull_distance
 from etsc_envs.cluster.params import FIGURE_5_CELLS
 
@@ -259,6 +265,12 @@ def _claims(
         )
     )
     return found
+
+
+def planned_instants(horizon_s: float = PAPER_HORIZON_S) -> int:
+    """The sampling instants of the runs :func:`reproduce` makes with ``horizon_s`` (its
+    progress's plan)."""
+    return scenario_instants(ENV_ID, SCENARIOS, horizon_s=horizon_s)
 
 
 def reproduce(

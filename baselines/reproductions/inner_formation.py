@@ -17,7 +17,13 @@ import numpy as np
 
 from baselines.episodes import EpisodeTrace
 from baselines.plotting import save
-from baselines.reproductions.report import Scenario, claim, metric_row, run_scenarios
+from baselines.reproductions.report import (
+    Scenario,
+    claim,
+    metric_row,
+    run_scenarios,
+    scenario_instants,
+)
 from etsc_envs.triggers.inner_formation import AXES, default_thresholds
 
 PAPER = "004"
@@ -214,6 +220,11 @@ def _figures(traces: dict[Scenario, EpisodeTrace], plot_dir: Path) -> list[str]:
         axes[-1].set_xlabel("time (s)")
         written.append(save(figure, plot_dir / f"fig{3 + axis}_estimation_{name}.png"))
     return [str(path) for path in written]
+
+
+def planned_instants() -> int:
+    """The sampling instants of the runs :func:`reproduce` makes (its progress's plan)."""
+    return scenario_instants(ENV_ID, SCENARIOS)
 
 
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:

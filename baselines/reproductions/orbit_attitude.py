@@ -22,11 +22,17 @@ from typing import Any
 import gymnasium as gym
 import matplotlib.pyplot as plt
 import numpy as np
-from tqdm import tqdm
 
 from baselines.cli import make_policy
+from baselines.episodes import instants_bar
 from baselines.plotting import plot_interevent, save
-from baselines.reproductions.report import Scenario, claim, metric_row, stages
+from baselines.reproductions.report import (
+    Scenario,
+    claim,
+    metric_row,
+    scenario_instants,
+    stages,
+)
 from etsc_envs.orbit_attitude.closed_loop import disturbance_step
 from etsc_envs.orbit_attitude.dynamics import thruster_outputs
 
@@ -108,7 +114,7 @@ def run_scenario(scenario: Scenario, progress: bool = False) -> Run:
     times, commands = [0.0], [unwrapped.held[0].copy()]
     total_return, steps = 0.0, 0
     started = time.perf_counter()
-    bar = tqdm(total=unwrapped.n_steps, disable=not progress, desc=scenario.label, leave=False)
+    bar = instants_bar(unwrapped.n_steps, progress, scenario.label)
     while True:
         action, _ = policy.predict(obs, deterministic=True)
         time_before = unwrapped.time_s
@@ -430,6 +436,11 @@ def _figures(runs: dict[Scenario, Run], plot_dir: Path) -> list[str]:
 
 
 # --------------------------------------------------------------------------- entry point
+def planned_instants() -> int:
+    """The sampling instants of the runs :func:`reproduce` makes (its progress's plan)."""
+    return scenario_instants(ENV_ID, SCENARIOS)
+
+
 def reproduce(plot_dir: Path | None = None, progress: bool = False) -> dict[str, Any]:
     """Run the four scenarios and compare with section IV's bounds and claims."""
     runs = {

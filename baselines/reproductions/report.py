@@ -12,8 +12,10 @@ from typing import Any
 
 import gymnasium as gym
 
+import etsc_envs
 from baselines.cli import make_policy
 from baselines.episodes import EpisodeTrace, run_episode
+from baselines.progress import current_job
 
 TEXT_WIDTH = 100
 """Columns the rendered report fits in."""
@@ -48,12 +50,34 @@ def run_scenario(
     return record, trace
 
 
+def scenario_instants(env_id: str, scenarios: Iterable[Scenario], **env_args: Any) -> int:
+    """The sampling instants of one run of each of ``scenarios`` on ``env_id`` (a Gymnasium or
+    PettingZoo id; ``env_args`` added to each scenario's): the work a reproduction plans, for
+    its progress."""
+    total = 0
+    for scenario in scenarios:
+        arguments = {**dict(scenario.env_args), **env_args}
+        if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+            env = etsc_envs.make_parallel(env_id, **arguments)
+        else:
+            env = gym.make(env_id, **arguments)
+        total += env.unwrapped.n_steps
+        env.close()
+    return total
+
+
 def stages(scenarios: Iterable[Scenario], description: str) -> Iterator[Scenario]:
-    """Yield ``scenarios``; after each one's run, write a line saying so to standard error
+    """Yield ``scenarios``. Inside an open :class:`~baselines.progress.JobProgress`, tell the
+    job which run starts; otherwise, after each run, write a line saying so to standard error
     (flushed, so that a long reproduction shows its progress when its output is redirected)."""
     scenarios = list(scenarios)
     start = time.perf_counter()
     for index, scenario in enumerate(scenarios, start=1):
+        job = current_job()
+        if job is not None:
+            job.stage(f"{description}: run {index}/{len(scenarios)} ({scenario.label})")
+            yield scenario
+            continue
         yield scenario
         elapsed_s = time.perf_counter() - start
         print(
