@@ -2,9 +2,10 @@
 
 Left, the cavity of radius R (``cavity_radius_m``) at true scale seen along z, with the inner
 mass's centre r (paper 004's relative position r_12, eq. 1) and its trail through the
-episode's frames. Right, a zoom on the centre of the same view showing what the event-triggered
-loop works with: r itself, the measurement each axis's observer last received r(t_k) (held
-since that axis's last event, eqs. 4-6) and the observer's estimate ζ (eq. 3).
+episode's frames. Right, a zoom of the same view centred on the mass, showing what the
+event-triggered loop works with: where the measurement each axis's observer last received,
+r(t_k), lies from r (held since that axis's last event; eqs. (4)-(6) send when an axis's gap
+passes Π_i) and where the observer's estimate ζ (eq. 3) lies, at the current instant.
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ from matplotlib.patches import Circle
 from etsc_envs.core.render import SystemPicture, bare_axes
 from etsc_envs.inner_formation.closed_loop import LOOP
 
-ZOOM_STEPS_MM = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)
-"""Half-widths of the zoom (mm): the smallest that holds the three points with a margin."""
+ZOOM_STEPS_UM = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1e3, 2e3, 5e3, 1e4, 1e5)
+"""Half-widths of the zoom (µm): the smallest that holds the three points with a margin."""
 
 
 def snapshot(env: Any) -> np.ndarray:
@@ -30,7 +31,7 @@ def snapshot(env: Any) -> np.ndarray:
 
 
 def draw(env: Any, figure: Figure, region: SubplotSpec, trail: np.ndarray) -> None:
-    """The cavity with the mass and its trail; the zoom on r, r(t_k) and ζ (x-y plane)."""
+    """The cavity with the mass and its trail; the zoom on r with r(t_k) and ζ (x-y plane)."""
     radius_mm = 1e3 * env.params.cavity_radius_m
     mm = 1e3 * trail
     cavity_axes, zoom_axes = (figure.add_subplot(cell) for cell in region.subgridspec(1, 2))
@@ -43,19 +44,19 @@ def draw(env: Any, figure: Figure, region: SubplotSpec, trail: np.ndarray) -> No
     cavity_axes.text(0.0, -0.12, f"|r| = {offset_mm:.3g} mm", transform=cavity_axes.transAxes,
                      fontsize=8)  # fmt: skip
 
-    current = mm[-1].reshape(3, 3)[:, 0:2]  # rows: r, ζ, r(t_k) in the x-y plane
-    reach = float(np.abs(current).max()) * 1.3
-    half = next((step for step in ZOOM_STEPS_MM if step >= reach), ZOOM_STEPS_MM[-1])
+    um = 1e3 * mm[-1].reshape(3, 3)[:, 0:2]  # rows: r, ζ, r(t_k) in the x-y plane, µm
+    offsets = um - um[0]  # the zoom is centred on the mass
+    reach = 1.3 * float(np.abs(offsets).max())
+    half = next((step for step in ZOOM_STEPS_UM if step >= reach), ZOOM_STEPS_UM[-1])
     bare_axes(zoom_axes, half)
     zoom_axes.axhline(0.0, color="0.85", linewidth=0.6)
     zoom_axes.axvline(0.0, color="0.85", linewidth=0.6)
-    zoom_axes.plot(mm[:, 0], mm[:, 1], color="0.45", linewidth=0.8)
-    zoom_axes.plot(*current[0], "o", color="black", markersize=6, label="r")
-    zoom_axes.plot(*current[2], "s", markerfacecolor="none", color="#ff7f0e", markersize=8,
+    zoom_axes.plot(0.0, 0.0, "o", color="black", markersize=6, label="r")
+    zoom_axes.plot(*offsets[2], "s", markerfacecolor="none", color="#ff7f0e", markersize=8,
                    markeredgewidth=1.5, label="r(t_k), held")  # fmt: skip
-    zoom_axes.plot(*current[1], "x", color="#17becf", markersize=8, markeredgewidth=1.5,
+    zoom_axes.plot(*offsets[1], "x", color="#17becf", markersize=8, markeredgewidth=1.5,
                    label="ζ, estimate")  # fmt: skip
-    zoom_axes.set_title(f"centre, ±{half:g} mm", fontsize=8)
+    zoom_axes.set_title(f"around the mass, ±{half:g} µm", fontsize=8)
     zoom_axes.legend(loc="upper center", bbox_to_anchor=(0.5, -0.02), fontsize=7, ncol=1,
                      frameon=False)  # fmt: skip
 
