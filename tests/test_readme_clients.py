@@ -1,6 +1,6 @@
-"""The README's client examples run word for word.
+"""The client examples of the README and ``docs/clients.md`` run word for word.
 
-Checked properties: each Python block of the README that uses PettingZoo's registry or Ray
+Checked properties: each Python block of those pages that uses PettingZoo's registry or Ray
 RLlib runs as written: the cluster from ``pettingzoo.make`` (both forms), RLlib multi-agent
 PPO with one shared policy over ``ParallelPettingZooEnv`` and RLlib PPO on a Gymnasium id,
 each RLlib one training iteration that samples the configured batch.
@@ -17,9 +17,17 @@ ROOT = Path(__file__).resolve().parents[1]
 PYTHON_BLOCK = re.compile(r"```python\n(.*?)```", re.DOTALL)
 
 
+PAGES = ("README.md", "docs/clients.md")
+"""The pages whose client examples are run."""
+
+
 def readme_blocks(marker: str) -> list[str]:
-    """The README's Python blocks that contain ``marker``."""
-    blocks = PYTHON_BLOCK.findall((ROOT / "README.md").read_text(encoding="utf-8"))
+    """The Python blocks of :data:`PAGES` that contain ``marker``."""
+    blocks = [
+        block
+        for page in PAGES
+        for block in PYTHON_BLOCK.findall((ROOT / page).read_text(encoding="utf-8"))
+    ]
     return [block for block in blocks if marker in block]
 
 
