@@ -311,12 +311,19 @@ def board_rows(records: Path, board: Board) -> list[Row]:
             records, board.self_triggered, "self-triggered PPO", board.self_triggered_label
         ),
     ]
-    learned = f"{board.name}_learned"
-    if (records / learned / "results.json").is_file():
-        rows.append(
-            _results_row(records, learned, "learned trigger (ES)", "parametric family, CMA-ES")
-        )
+    for folder in sorted(records.glob(f"{board.name}_learned*/results.json")):
+        name = folder.parent.name
+        variant = name.removeprefix(f"{board.name}_learned").strip("_").replace("_", " ")
+        trigger = LEARNED + (f", {variant})" if variant else ")")
+        seeds = len(_load(folder)["models"])
+        what = f"the rule's parametric family searched with CMA-ES ({seeds} search seeds)"
+        rows.append(_results_row(records, name, trigger, what))
     return rows
+
+
+LEARNED = "learned trigger (ES"
+"""The start of a learned trigger's row name; a ``<EnvName>_learned_<variant>/`` record adds
+its variant (``learned trigger (ES, modulated)``)."""
 
 
 def _number(value: float) -> str:
@@ -364,9 +371,9 @@ SUMMARY_TRIGGERS = (
     "best hand-designed rule",
     "per-instant PPO",
     "self-triggered PPO",
-    "learned trigger (ES)",
 )
-"""The triggers of the across-id summary, each over the ids whose record keeps its test episodes."""
+"""The triggers of the across-id summary (with every learned trigger found), each over the ids
+whose record keeps its test episodes."""
 
 
 def _scenario_scores(measure: Measure, reference: Measure) -> tuple[np.ndarray, np.ndarray]:
@@ -384,7 +391,8 @@ def across_ids(boards: dict[str, list[Row]]) -> list[dict[str, Any]]:
     per-scenario ratios to the paper's rule (cost and transmissions) and the probability of a
     lower cost than the rule, with bootstrap intervals over the scenarios of all those ids."""
     summary = []
-    for trigger in SUMMARY_TRIGGERS:
+    learned = sorted({row.trigger for rows in boards.values() for row in rows} - set(ROW_STYLES))
+    for trigger in (*SUMMARY_TRIGGERS, *learned):
         costs, sents, paper_costs, paper_sents, ids = [], [], [], [], []
         for env_id, rows in boards.items():
             by_name = {row.trigger: row for row in rows}
@@ -439,9 +447,23 @@ ROW_STYLES = {
     "best hand-designed rule": {"marker": "*", "color": "C3", "markersize": 16},
     "per-instant PPO": {"marker": "^", "color": "C4", "markersize": 10},
     "self-triggered PPO": {"marker": "v", "color": "C5", "markersize": 10},
-    "learned trigger (ES)": {"marker": "D", "color": "C2", "markersize": 10},
 }
-"""Each row's marker in the figures."""
+"""Each row's marker in the figures; a learned trigger takes one of :data:`LEARNED_STYLES`."""
+
+LEARNED_STYLES = (
+    {"marker": "D", "color": "C2", "markersize": 10},
+    {"marker": "P", "color": "C9", "markersize": 11},
+    {"marker": "X", "color": "C6", "markersize": 11},
+)
+
+
+def _style(trigger: str, triggers: list[str]) -> dict[str, Any]:
+    """The marker of ``trigger`` among a figure's ``triggers``."""
+    if trigger in ROW_STYLES:
+        return ROW_STYLES[trigger]
+    learned = [name for name in triggers if name not in ROW_STYLES]
+    return LEARNED_STYLES[learned.index(trigger) % len(LEARNED_STYLES)]
+
 
 SWEEP_STYLES = {
     "paper": ("o-", "C0", "paper's rule, threshold sweep"),
@@ -527,7 +549,7 @@ def _panel(
     off_axes: list[str] = []
     for trigger, measure in measures:
         x, y = measure.sent["mean"], measure.cost["mean"]
-        style = ROW_STYLES[trigger]
+        style = _style(trigger, [row.trigger for row in rows])
         if x_low <= x <= x_high and y_low <= y <= y_high:
             interval = measure.cost.get("mean_ci95")
             narrow = interval is not None and interval[1] - interval[0] < NARROW * (y_high - y_low)
@@ -592,7 +614,8 @@ def figure(board: Board, rows: list[Row], sweeps: dict[str, Any], path: Path) ->
     panels[0].set_ylabel("mean cost per step (lower is better)")
     handles, labels = panels[0].get_legend_handles_labels()
     for trigger in [row.trigger for row in rows if any(row.sets.values())]:
-        handles.append(plt.Line2D([], [], linestyle="", **ROW_STYLES[trigger]))
+        style = _style(trigger, [row.trigger for row in rows])
+        handles.append(plt.Line2D([], [], linestyle="", **style))
         labels.append(trigger)
     handles.append(plt.Line2D([], [], marker="x", linestyle="", color="k", markersize=9))
     labels.append("failures in some episodes")

@@ -78,6 +78,12 @@ def test_a_learned_record_adds_its_row(tmp_path: Path) -> None:
         assert learned.sets[name].cost["mean"] == pytest.approx(best.sets[name].cost["mean"] / 2)
         assert learned.sets[name].sent["mean"] == best.sets[name].sent["mean"]
 
+    # a variant of the search gets its own row, named by its folder's suffix
+    (records / f"{BOARD.name}_learned_modulated").mkdir()
+    (records / f"{BOARD.name}_learned_modulated" / "results.json").write_text(json.dumps(record))
+    triggers = [row.trigger for row in leaderboard.board_rows(records, BOARD)]
+    assert triggers[-2:] == ["learned trigger (ES)", "learned trigger (ES, modulated)"]
+
 
 def test_records_of_other_scenarios_are_refused() -> None:
     rows = {row.trigger: row for row in leaderboard.board_rows(leaderboard.RECORDS, BOARD)}
