@@ -73,7 +73,7 @@ from baselines.cli import (
     require_policies,
     write_json,
 )
-from baselines.evaluate import evaluate
+from baselines.evaluate import evaluate, positive_integer
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.protocol import DEFAULT_SET_SIZE
@@ -535,7 +535,7 @@ def main(argv: list[str] | None = None) -> int:
         help="an SB3 zip or a learned trigger (learned:PATH or .json; repeatable)",
     )
     parser.add_argument("--scenarios", choices=("test", "validation"), default="test")
-    parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
+    parser.add_argument("--set-size", type=positive_integer, default=DEFAULT_SET_SIZE, metavar="K")
     parser.add_argument(
         "--sweep",
         action="append",

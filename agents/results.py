@@ -54,7 +54,7 @@ from baselines.cli import (
     require_policies,
     write_json,
 )
-from baselines.evaluate import evaluate
+from baselines.evaluate import evaluate, positive_integer
 from baselines.statistics import paired_ratio, seeds_ratio
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.protocol import DEFAULT_SET_SIZE, PROTOCOL_VERSION, SCENARIO_SET_NAMES
@@ -415,7 +415,7 @@ def main(argv: list[str] | None = None) -> int:
         default=["paper", "test"],
         help="scenario sets to judge on (default: paper test)",
     )
-    parser.add_argument("--set-size", type=int, default=DEFAULT_SET_SIZE, metavar="K")
+    parser.add_argument("--set-size", type=positive_integer, default=DEFAULT_SET_SIZE, metavar="K")
     parser.add_argument("--env-arg", action="append", metavar="K=V", help="environment kwarg")
     parser.add_argument(
         "--out",

@@ -227,7 +227,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument(
         "--set-size",
-        type=_positive_integer,
+        type=positive_integer,
         default=DEFAULT_SET_SIZE,
         metavar="K",
         help=f"scenarios of the validation or test set (default {DEFAULT_SET_SIZE})",
@@ -300,8 +300,8 @@ def _horizon_s(env: Any) -> float:
     return float(getattr(unwrapped, "loop", unwrapped).horizon_s)
 
 
-def _positive_integer(text: str) -> int:
-    """``--set-size``: an integer >= 1."""
+def positive_integer(text: str) -> int:
+    """``--set-size`` of every command that judges on a scenario set: an integer >= 1."""
     try:
         value = int(text)
     except ValueError:
