@@ -45,7 +45,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from etsc_envs.core.jit import closure_jit
+from etsc_envs.core.jit import closure_jit, jit
 from etsc_envs.triggers.base import (
     RuleTrigger,
     time_since_transmission_indices,
@@ -266,6 +266,21 @@ def _read_number(value: Any) -> float:
     return math.inf if value == "inf" else float(value)
 
 
+@jit
+def dense_layer(parameters, offset, inputs, out, squash):
+    """One layer of the modulation network: ``out = W inputs + b`` (``tanh`` of it if
+    ``squash``), with W (row-major, ``len(out) × len(inputs)``) then b read from
+    ``parameters`` at ``offset``; returns the offset after them."""
+    n_in = inputs.shape[0]
+    n_out = out.shape[0]
+    for j in range(n_out):
+        total = parameters[offset + n_out * n_in + j]
+        for i in range(n_in):
+            total += parameters[offset + j * n_in + i] * inputs[i]
+        out[j] = np.tanh(total) if squash else total
+    return offset + n_out * n_in + n_out
+
+
 @functools.cache
 def family_rule(
     condition: Callable[..., None], conditions_per_channel: int, strict: bool
@@ -302,25 +317,13 @@ def family_rule(
                 )
             q += 2 * n_inputs
             hidden1 = np.empty(h1)
-            for j in range(h1):
-                total = parameters[q + h1 * n_inputs + j]
-                for i in range(n_inputs):
-                    total += parameters[q + j * n_inputs + i] * x[i]
-                hidden1[j] = np.tanh(total)
-            q += h1 * n_inputs + h1
+            q = dense_layer(parameters, q, x, hidden1, True)
             hidden2 = np.empty(h2)
-            for j in range(h2):
-                total = parameters[q + h2 * h1 + j]
-                for i in range(h1):
-                    total += parameters[q + j * h1 + i] * hidden1[i]
-                hidden2[j] = np.tanh(total)
-            q += h2 * h1 + h2
+            q = dense_layer(parameters, q, hidden1, hidden2, True)
             g = np.empty(3)
+            dense_layer(parameters, q, hidden2, g, False)
             for j in range(3):
-                total = parameters[q + 3 * h2 + j]
-                for i in range(h2):
-                    total += parameters[q + j * h2 + i] * hidden2[i]
-                g[j] = min(max(total, -MODULATION_BOUND), MODULATION_BOUND)
+                g[j] = min(max(g[j], -MODULATION_BOUND), MODULATION_BOUND)
             g_threshold = g[0]
             g_floor = g[1]
             g_heartbeat = g[2]
