@@ -15,6 +15,15 @@ from etsc_envs.core.jit import jit
 
 
 @jit
+def as_array(values) -> np.ndarray:
+    """A new float64 array holding the entries of ``values`` (a tuple of floats or an array)."""
+    out = np.empty(len(values))
+    for i in range(len(values)):
+        out[i] = values[i]
+    return out
+
+
+@jit
 def matvec(matrix: np.ndarray, vector: np.ndarray) -> np.ndarray:
     """``matrix @ vector`` for an m×n matrix and an n-vector."""
     rows, columns = matrix.shape
@@ -130,15 +139,20 @@ def fused_matvec3_transposed(matrix: np.ndarray, vector) -> np.ndarray:
 
 
 @jit
+def fused_dot6(row, vector) -> float:
+    """``row @ vector`` for 6-vectors (arrays or tuples), as ``((m_0 v_0 + m_2 v_2) +
+    (m_1 v_1 + m_3 v_3)) + fma(m_4, v_4, m_5 v_5)``: OpenBLAS's ``dgemv`` on the transposed view
+    sums the first four products in vector lanes and adds the last two separately, and returns
+    this value bit for bit as an entry of a matrix-vector product."""
+    lanes = (row[0] * vector[0] + row[2] * vector[2]) + (row[1] * vector[1] + row[3] * vector[3])
+    return lanes + fused_multiply_add(row[4], vector[4], row[5] * vector[5])
+
+
+@jit
 def fused_row_dot6(matrix: np.ndarray, row: int, vector: np.ndarray) -> float:
-    """Entry ``row`` of ``matrix @ vector`` for a C-ordered matrix of 6 columns, as
-    ``((m_0 v_0 + m_2 v_2) + (m_1 v_1 + m_3 v_3)) + fma(m_4, v_4, m_5 v_5)``: OpenBLAS's
-    ``dgemv`` on the transposed view sums the first four products in vector lanes and adds the
-    last two separately, and returns this value bit for bit."""
-    lanes = (matrix[row, 0] * vector[0] + matrix[row, 2] * vector[2]) + (
-        matrix[row, 1] * vector[1] + matrix[row, 3] * vector[3]
-    )
-    return lanes + fused_multiply_add(matrix[row, 4], vector[4], matrix[row, 5] * vector[5])
+    """Entry ``row`` of ``matrix @ vector`` for a C-ordered matrix of 6 columns
+    (:func:`fused_dot6` of the row)."""
+    return fused_dot6(matrix[row], vector)
 
 
 @jit

@@ -20,22 +20,31 @@ import numpy as np
 
 from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import fused_dot, fused_matmul, fused_matvec3
+from etsc_envs.core.linalg import (
+    fused_dot,
+    fused_dot6,
+    fused_matmul,
+    fused_matvec3,
+    fused_multiply_add,
+)
 
 _SMALL_ANGLE = 1e-8
 
 
+IDENTITY_ROWS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+"""The 3×3 identity as a :data:`~etsc_envs.core.vec3.Mat3`."""
+
+
+@jit
+def skew_rows(a) -> vec3.Mat3:
+    """Cross-product matrix ``a^×`` such that ``a^× b = a × b``, as the tuple of its rows."""
+    return ((0.0, -a[2], a[1]), (a[2], 0.0, -a[0]), (-a[1], a[0], 0.0))
+
+
 @jit
 def skew(a: np.ndarray) -> np.ndarray:
-    """Cross-product matrix ``a^×`` such that ``a^× b = a × b``."""
-    out = np.zeros((3, 3))
-    out[0, 1] = -a[2]
-    out[0, 2] = a[1]
-    out[1, 0] = a[2]
-    out[1, 2] = -a[0]
-    out[2, 0] = -a[1]
-    out[2, 1] = a[0]
-    return out
+    """Cross-product matrix ``a^×`` such that ``a^× b = a × b`` (:func:`skew_rows`)."""
+    return vec3.to_matrix(skew_rows(a))
 
 
 @jit
@@ -117,22 +126,36 @@ def error_quaternion(q: np.ndarray, q_desired: np.ndarray) -> np.ndarray:
 
 
 @jit
-def attitude_matrix(q: np.ndarray) -> np.ndarray:
-    """DCM ``(1 - 2 q_vᵀq_v) I + 2 q_v q_vᵀ - 2 q4 q_v^×`` mapping R-frame to B-frame components."""
+def attitude_rows(q) -> vec3.Mat3:
+    """DCM ``(1 - 2 q_vᵀq_v) I + 2 q_v q_vᵀ - 2 q4 q_v^×`` mapping R-frame to B-frame
+    components, as the tuple of its rows (:data:`~etsc_envs.core.vec3.Mat3`)."""
     x, y, z = q[0], q[1], q[2]
     diagonal = 1.0 - 2.0 * vec3.dot(q, q)
     twice_scalar = 2.0 * q[3]
-    out = np.empty((3, 3))
-    out[0, 0] = diagonal + 2.0 * (x * x)
-    out[1, 1] = diagonal + 2.0 * (y * y)
-    out[2, 2] = diagonal + 2.0 * (z * z)
-    out[0, 1] = 2.0 * (x * y) - twice_scalar * -z
-    out[0, 2] = 2.0 * (x * z) - twice_scalar * y
-    out[1, 0] = 2.0 * (y * x) - twice_scalar * z
-    out[1, 2] = 2.0 * (y * z) - twice_scalar * -x
-    out[2, 0] = 2.0 * (z * x) - twice_scalar * -y
-    out[2, 1] = 2.0 * (z * y) - twice_scalar * x
-    return out
+    return (
+        (
+            diagonal + 2.0 * (x * x),
+            2.0 * (x * y) - twice_scalar * -z,
+            2.0 * (x * z) - twice_scalar * y,
+        ),
+        (
+            2.0 * (y * x) - twice_scalar * z,
+            diagonal + 2.0 * (y * y),
+            2.0 * (y * z) - twice_scalar * -x,
+        ),
+        (
+            2.0 * (z * x) - twice_scalar * -y,
+            2.0 * (z * y) - twice_scalar * x,
+            diagonal + 2.0 * (z * z),
+        ),
+    )
+
+
+@jit
+def attitude_matrix(q: np.ndarray) -> np.ndarray:
+    """DCM ``(1 - 2 q_vᵀq_v) I + 2 q_v q_vᵀ - 2 q4 q_v^×`` mapping R-frame to B-frame components
+    (:func:`attitude_rows` as an array)."""
+    return vec3.to_matrix(attitude_rows(q))
 
 
 @jit
@@ -170,27 +193,37 @@ def so3_exp(phi: np.ndarray) -> np.ndarray:
 
 
 @jit
-def so3_log(rotation: np.ndarray) -> np.ndarray:
-    """Rotation vector φ with ``so3_exp(φ) = rotation`` and ``‖φ‖ ≤ π``.
+def so3_log_rows(rotation) -> vec3.Vec3:
+    """Rotation vector φ with ``so3_exp(φ) = rotation`` and ``‖φ‖ ≤ π``, for a rotation given
+    by its rows (a :data:`~etsc_envs.core.vec3.Mat3` or an array), as a tuple.
 
     The angle is ``atan2(sin θ, cos θ)`` from the antisymmetric part and the trace, which stays
     accurate near π where ``arccos`` of the trace does not.
     """
-    cos_angle = min(1.0, max(-1.0, 0.5 * (np.trace(rotation) - 1.0)))
-    axis_sin = 0.5 * np.array(
-        [
-            rotation[2, 1] - rotation[1, 2],
-            rotation[0, 2] - rotation[2, 0],
-            rotation[1, 0] - rotation[0, 1],
-        ]
+    trace = ((0.0 + rotation[0][0]) + rotation[1][1]) + rotation[2][2]
+    cos_angle = min(1.0, max(-1.0, 0.5 * (trace - 1.0)))
+    axis_sin = (
+        0.5 * (rotation[2][1] - rotation[1][2]),
+        0.5 * (rotation[0][2] - rotation[2][0]),
+        0.5 * (rotation[1][0] - rotation[0][1]),
     )
-    sin_angle = np.sqrt(fused_dot(axis_sin, axis_sin))
+    sin_angle = np.sqrt(vec3.dot(axis_sin, axis_sin))
     angle = np.arctan2(sin_angle, cos_angle)
     if angle < 1e-6:
         return axis_sin
     if sin_angle > 1e-3 or cos_angle > 0.0:
-        return angle / sin_angle * axis_sin
-    # Near π the axis comes from the symmetric part: (R + Rᵀ)/2 = cos θ I + (1 - cos θ) a aᵀ.
+        return vec3.scale(angle / sin_angle, axis_sin)
+    return vec3.as_vec3(
+        _so3_log_near_pi(vec3.to_matrix(rotation), cos_angle, vec3.to_array(axis_sin), angle)
+    )
+
+
+@jit
+def _so3_log_near_pi(
+    rotation: np.ndarray, cos_angle: float, axis_sin: np.ndarray, angle: float
+) -> np.ndarray:
+    """:func:`so3_log_rows` near π, where the axis comes from the symmetric part:
+    ``(R + Rᵀ)/2 = cos θ I + (1 - cos θ) a aᵀ``."""
     outer = (0.5 * (rotation + rotation.T) - cos_angle * np.eye(3)) / (1.0 - cos_angle)
     column = int(np.argmax(np.diag(outer)))
     axis = outer[:, column] / np.sqrt(outer[column, column])
@@ -200,18 +233,37 @@ def so3_log(rotation: np.ndarray) -> np.ndarray:
 
 
 @jit
-def so3_left_jacobian(phi: np.ndarray) -> np.ndarray:
-    """Left Jacobian of SO(3), the map from twist to translation in :func:`se3_exp`."""
-    angle = np.sqrt(fused_dot(phi, phi))
-    phi_x = skew(phi)
+def so3_log(rotation: np.ndarray) -> np.ndarray:
+    """Rotation vector φ with ``so3_exp(φ) = rotation`` and ``‖φ‖ ≤ π`` (:func:`so3_log_rows`)."""
+    return vec3.to_array(so3_log_rows(rotation))
+
+
+@jit
+def so3_left_jacobian_rows(phi) -> vec3.Mat3:
+    """Left Jacobian of SO(3), the map from twist to translation in :func:`se3_exp`, as the
+    tuple of its rows."""
+    angle = np.sqrt(vec3.dot(phi, phi))
+    phi_x = skew_rows(phi)
     if angle < _SMALL_ANGLE:
-        return np.eye(3) + 0.5 * phi_x + fused_matmul(phi_x, phi_x) / 6.0
+        return vec3.rows_add(
+            vec3.rows_add(IDENTITY_ROWS, vec3.rows_scale(0.5, phi_x)),
+            vec3.rows_divide(vec3.product(phi_x, phi_x), 6.0),
+        )
     if angle < 0.1:  # (θ - sin θ)/θ³ by its series: the closed form cancels to ~1e-16/θ²
         a2 = angle * angle
         third = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0 - a2 * a2 * a2 / 362880.0
     else:
         third = (angle - np.sin(angle)) / angle**3
-    return np.eye(3) + _one_minus_cos_over_sq(angle) * phi_x + fused_matmul(third * phi_x, phi_x)
+    return vec3.rows_add(
+        vec3.rows_add(IDENTITY_ROWS, vec3.rows_scale(_one_minus_cos_over_sq(angle), phi_x)),
+        vec3.product(vec3.rows_scale(third, phi_x), phi_x),
+    )
+
+
+@jit
+def so3_left_jacobian(phi: np.ndarray) -> np.ndarray:
+    """Left Jacobian of SO(3) (:func:`so3_left_jacobian_rows`) as an array."""
+    return vec3.to_matrix(so3_left_jacobian_rows(phi))
 
 
 @jit
@@ -224,12 +276,20 @@ def se3_exp(xi: np.ndarray) -> np.ndarray:
 
 
 @jit
+def se3_log_parts(rotation, position) -> tuple[vec3.Vec3, vec3.Vec3]:
+    """Exponential coordinates ``(φ, χ)`` with ``se3_exp([φ, χ]) = [[R, p], [0, 1]]`` for the
+    rotation ``R`` given by its rows and the translation ``p``, as two tuples."""
+    phi = so3_log_rows(rotation)
+    return phi, vec3.solve_rows(so3_left_jacobian_rows(phi), position)
+
+
+@jit
 def se3_log(g: np.ndarray) -> np.ndarray:
-    """Exponential coordinates ``ξ = [φ, χ]`` with ``se3_exp(ξ) = g``."""
-    phi = so3_log(g[:3, :3])
+    """Exponential coordinates ``ξ = [φ, χ]`` with ``se3_exp(ξ) = g`` (:func:`se3_log_parts`)."""
+    phi, chi = se3_log_parts(g[:3, :3], g[:3, 3])
     xi = np.empty(6)
-    xi[:3] = phi
-    xi[3:] = solve3(so3_left_jacobian(phi), np.ascontiguousarray(g[:3, 3]))
+    vec3.store(xi[:3], phi)
+    vec3.store(xi[3:], chi)
     return xi
 
 
@@ -335,6 +395,63 @@ def mrp_kinematics_matrix_rate(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.n
 
 
 @jit
+def block_lower_times(diagonal, lower, vector) -> tuple:
+    """``[[D, 0], [L, D]] @ v`` for 3×3 blocks D and L given by their rows and a 6-vector v, as
+    a 6-tuple: bit for bit :func:`~etsc_envs.core.linalg.fused_matvec6` of the 6×6 array (its
+    upper-right block +0)."""
+    d, low = diagonal, lower
+    return (
+        fused_dot6((d[0][0], d[0][1], d[0][2], 0.0, 0.0, 0.0), vector),
+        fused_dot6((d[1][0], d[1][1], d[1][2], 0.0, 0.0, 0.0), vector),
+        fused_dot6((d[2][0], d[2][1], d[2][2], 0.0, 0.0, 0.0), vector),
+        fused_dot6((low[0][0], low[0][1], low[0][2], d[0][0], d[0][1], d[0][2]), vector),
+        fused_dot6((low[1][0], low[1][1], low[1][2], d[1][0], d[1][1], d[1][2]), vector),
+        fused_dot6((low[2][0], low[2][1], low[2][2], d[2][0], d[2][1], d[2][2]), vector),
+    )
+
+
+@jit
+def pose_product(rotation1, position1, rotation2, position2) -> tuple[vec3.Mat3, vec3.Vec3]:
+    """``g1 g2`` for ``g = [[R, p], [0, 1]]`` given as rotation rows and translation, as
+    ``(R, p)``: bit for bit the 4×4 :func:`~etsc_envs.core.linalg.fused_matmul` (each entry a
+    fused multiply-add chain over the four columns of g1, the last with g2's bottom row)."""
+    rotation = vec3.product(rotation1, rotation2)
+    position = vec3.rows_matvec_chain(rotation1, position2)
+    return (
+        (
+            (
+                fused_multiply_add(position1[0], 0.0, rotation[0][0]),
+                fused_multiply_add(position1[0], 0.0, rotation[0][1]),
+                fused_multiply_add(position1[0], 0.0, rotation[0][2]),
+            ),
+            (
+                fused_multiply_add(position1[1], 0.0, rotation[1][0]),
+                fused_multiply_add(position1[1], 0.0, rotation[1][1]),
+                fused_multiply_add(position1[1], 0.0, rotation[1][2]),
+            ),
+            (
+                fused_multiply_add(position1[2], 0.0, rotation[2][0]),
+                fused_multiply_add(position1[2], 0.0, rotation[2][1]),
+                fused_multiply_add(position1[2], 0.0, rotation[2][2]),
+            ),
+        ),
+        (
+            fused_multiply_add(position1[0], 1.0, position[0]),
+            fused_multiply_add(position1[1], 1.0, position[1]),
+            fused_multiply_add(position1[2], 1.0, position[2]),
+        ),
+    )
+
+
+@jit
+def pose_inverse(rotation, position) -> tuple[vec3.Mat3, vec3.Vec3]:
+    """``g⁻¹ = [[Rᵀ, -Rᵀ p], [0, 1]]`` for ``g = [[R, p], [0, 1]]`` given as rotation rows and
+    translation, as ``(Rᵀ, -Rᵀ p)`` (the values of :func:`se3_inverse`)."""
+    rotation_t = vec3.transpose(rotation)
+    return rotation_t, vec3.rows_matvec(vec3.rows_negate(rotation_t), position)
+
+
+@jit
 def se3_adjoint(g: np.ndarray) -> np.ndarray:
     """Adjoint ``Ad_g = [[R, 0], [r^× R, R]]`` (6×6), so that ``(Ad_g V)^ = g V^ g⁻¹``."""
     rotation = np.ascontiguousarray(g[:3, :3])
@@ -368,34 +485,53 @@ def se3_coad(twist: np.ndarray) -> np.ndarray:
 
 
 @jit
-def so3_right_jacobian_inverse(phi: np.ndarray) -> np.ndarray:
-    """``J_r⁻¹(φ) = I + ½ φ^× + (1/θ² - (1 + cos θ)/(2θ sin θ)) (φ^×)²`` for ``θ = ‖φ‖ < π``.
+def so3_right_jacobian_inverse_rows(phi) -> vec3.Mat3:
+    """``J_r⁻¹(φ) = I + ½ φ^× + (1/θ² - (1 + cos θ)/(2θ sin θ)) (φ^×)²`` for ``θ = ‖φ‖ < π``,
+    as the tuple of its rows.
 
     It maps a body-frame rate to the rate of the exponential coordinates:
     ``Ṙ = R ω^×`` with ``R = exp(φ^×)`` gives ``φ̇ = J_r⁻¹(φ) ω``.
     """
-    angle = np.sqrt(fused_dot(phi, phi))
-    phi_x = skew(phi)
+    angle = np.sqrt(vec3.dot(phi, phi))
+    phi_x = skew_rows(phi)
     if angle < 0.1:
         a2 = angle * angle
         coefficient = 1.0 / 12.0 + a2 / 720.0 + a2 * a2 / 30240.0 + a2 * a2 * a2 / 1209600.0
     else:
         coefficient = 1.0 / angle**2 - (1.0 + np.cos(angle)) / (2.0 * angle * np.sin(angle))
-    out = fused_matmul(coefficient * phi_x, phi_x)
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = ((1.0 if i == j else 0.0) + 0.5 * phi_x[i, j]) + out[i, j]
-    return out
+    square = vec3.product(vec3.rows_scale(coefficient, phi_x), phi_x)
+    return (
+        _identity_row_plus(0, phi_x[0], square[0]),
+        _identity_row_plus(1, phi_x[1], square[1]),
+        _identity_row_plus(2, phi_x[2], square[2]),
+    )
 
 
 @jit
-def se3_left_jacobian_coupling(phi: np.ndarray, rho: np.ndarray) -> np.ndarray:
-    """The off-diagonal block ``Q(φ, ρ)`` of the left Jacobian of SE(3) (Barfoot's form).
+def _identity_row_plus(row: int, half_of, plus) -> vec3.Vec3:
+    """Row ``row`` of ``(I + ½ half_of) + plus`` from the rows ``half_of`` and ``plus``."""
+    return (
+        ((1.0 if row == 0 else 0.0) + 0.5 * half_of[0]) + plus[0],
+        ((1.0 if row == 1 else 0.0) + 0.5 * half_of[1]) + plus[1],
+        ((1.0 if row == 2 else 0.0) + 0.5 * half_of[2]) + plus[2],
+    )
+
+
+@jit
+def so3_right_jacobian_inverse(phi: np.ndarray) -> np.ndarray:
+    """``J_r⁻¹(φ)`` (:func:`so3_right_jacobian_inverse_rows`) as an array."""
+    return vec3.to_matrix(so3_right_jacobian_inverse_rows(phi))
+
+
+@jit
+def se3_left_jacobian_coupling_rows(phi, rho) -> vec3.Mat3:
+    """The off-diagonal block ``Q(φ, ρ)`` of the left Jacobian of SE(3) (Barfoot's form), as
+    the tuple of its rows.
 
     ``J_l(ξ) = [[J_l(φ), 0], [Q(φ, ρ), J_l(φ)]]`` for ``ξ = [φ, ρ]``; series coefficients are
     used below θ = 0.1, where the closed forms lose digits to cancellation.
     """
-    angle = np.sqrt(fused_dot(phi, phi))
+    angle = np.sqrt(vec3.dot(phi, phi))
     a2 = angle * angle
     if angle < 0.1:
         c1 = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0 - a2 * a2 * a2 / 362880.0
@@ -406,43 +542,107 @@ def se3_left_jacobian_coupling(phi: np.ndarray, rho: np.ndarray) -> np.ndarray:
         c1 = (angle - s) / angle**3
         c2 = (a2 + 2.0 * c - 2.0) / (2.0 * a2 * a2)
         c3 = (2.0 * angle - 3.0 * s + angle * c) / (2.0 * a2 * a2 * angle)
-    p = skew(phi)
-    r = skew(rho)
-    pr = fused_matmul(p, r)
-    rp = fused_matmul(r, p)
-    prp = fused_matmul(pr, p)
-    pp = fused_matmul(p, p)
-    ppr = fused_matmul(pp, r)
-    rpp = fused_matmul(rp, p)
-    prpp = fused_matmul(prp, p)
-    pprp = fused_matmul(ppr, p)
-    out = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = (
-                0.5 * r[i, j]
-                + c1 * (pr[i, j] + rp[i, j] + prp[i, j])
-                + c2 * (ppr[i, j] + rpp[i, j] - 3.0 * prp[i, j])
-                + c3 * (prpp[i, j] + pprp[i, j])
-            )
-    return out
+    p = skew_rows(phi)
+    r = skew_rows(rho)
+    pr = vec3.product(p, r)
+    rp = vec3.product(r, p)
+    prp = vec3.product(pr, p)
+    pp = vec3.product(p, p)
+    ppr = vec3.product(pp, r)
+    rpp = vec3.product(rp, p)
+    prpp = vec3.product(prp, p)
+    pprp = vec3.product(ppr, p)
+    return (
+        _coupling_row(0, r, pr, rp, prp, ppr, rpp, prpp, pprp, c1, c2, c3),
+        _coupling_row(1, r, pr, rp, prp, ppr, rpp, prpp, pprp, c1, c2, c3),
+        _coupling_row(2, r, pr, rp, prp, ppr, rpp, prpp, pprp, c1, c2, c3),
+    )
 
 
 @jit
-def se3_right_jacobian_inverse(xi: np.ndarray) -> np.ndarray:
-    """``G(ξ) = J_r⁻¹(ξ) = [[A, 0], [T, A]]`` (6×6) for exponential coordinates ``ξ = [φ, ρ]``.
+def _coupling_entry(r, pr, rp, prp, ppr, rpp, prpp, pprp, c1, c2, c3) -> float:
+    """One entry of :func:`se3_left_jacobian_coupling_rows` from the same entry of each
+    product."""
+    return 0.5 * r + c1 * (pr + rp + prp) + c2 * (ppr + rpp - 3.0 * prp) + c3 * (prpp + pprp)
+
+
+@jit
+def _coupling_row(i, r, pr, rp, prp, ppr, rpp, prpp, pprp, c1, c2, c3) -> vec3.Vec3:
+    """Row ``i`` of :func:`se3_left_jacobian_coupling_rows` from the products' rows."""
+    return (
+        _coupling_entry(
+            r[i][0],
+            pr[i][0],
+            rp[i][0],
+            prp[i][0],
+            ppr[i][0],
+            rpp[i][0],
+            prpp[i][0],
+            pprp[i][0],
+            c1,
+            c2,
+            c3,
+        ),
+        _coupling_entry(
+            r[i][1],
+            pr[i][1],
+            rp[i][1],
+            prp[i][1],
+            ppr[i][1],
+            rpp[i][1],
+            prpp[i][1],
+            pprp[i][1],
+            c1,
+            c2,
+            c3,
+        ),
+        _coupling_entry(
+            r[i][2],
+            pr[i][2],
+            rp[i][2],
+            prp[i][2],
+            ppr[i][2],
+            rpp[i][2],
+            prpp[i][2],
+            pprp[i][2],
+            c1,
+            c2,
+            c3,
+        ),
+    )
+
+
+@jit
+def se3_right_jacobian_inverse_blocks(phi, rho) -> tuple[vec3.Mat3, vec3.Mat3]:
+    """The blocks ``(A, T)`` of ``G(ξ) = J_r⁻¹(ξ) = [[A, 0], [T, A]]`` for exponential
+    coordinates ``ξ = [φ, ρ]``, each as the tuple of its rows.
 
     With ``g = exp(ξ^)`` and ``ġ = g V^`` (body-frame twist V), ``ξ̇ = G(ξ) V``. Here
     ``A = J_r⁻¹(φ)`` and ``T = -A Q(-φ, -ρ) A``, since ``J_r(ξ) = J_l(-ξ)``.
     """
-    phi = np.ascontiguousarray(xi[:3])
-    rho = np.ascontiguousarray(xi[3:])
-    a = so3_right_jacobian_inverse(phi)
+    a = so3_right_jacobian_inverse_rows(phi)
+    coupling = se3_left_jacobian_coupling_rows(vec3.negate(phi), vec3.negate(rho))
+    return a, vec3.product(vec3.product(vec3.rows_negate(a), coupling), a)
+
+
+@jit
+def se3_right_jacobian_inverse(xi: np.ndarray) -> np.ndarray:
+    """``G(ξ) = J_r⁻¹(ξ) = [[A, 0], [T, A]]`` (6×6) for exponential coordinates ``ξ = [φ, ρ]``
+    (:func:`se3_right_jacobian_inverse_blocks`)."""
+    a, t = se3_right_jacobian_inverse_blocks(xi[:3], xi[3:])
     out = np.zeros((6, 6))
-    out[:3, :3] = a
-    out[3:, 3:] = a
-    out[3:, :3] = fused_matmul(fused_matmul(-a, se3_left_jacobian_coupling(-phi, -rho)), a)
+    out[:3, :3] = vec3.to_matrix(a)
+    out[3:, 3:] = vec3.to_matrix(a)
+    out[3:, :3] = vec3.to_matrix(t)
     return out
+
+
+@jit
+def se3_right_jacobian_inverse_times(phi, rho, twist) -> tuple:
+    """``G(ξ) V`` for ``ξ = [φ, ρ]`` and a 6-vector ``V``, as a 6-tuple: bit for bit
+    :func:`~etsc_envs.core.linalg.fused_matvec6` of :func:`se3_right_jacobian_inverse`."""
+    a, t = se3_right_jacobian_inverse_blocks(phi, rho)
+    return block_lower_times(a, t, twist)
 
 
 # --------------------------------------------------------------------------- Euler angles

@@ -148,20 +148,36 @@ def matvec_transposed(matrix: np.ndarray, vector) -> Vec3:
 
 
 @jit
+def rows(matrix: np.ndarray) -> Mat3:
+    """The rows of a 3×3 array as a :data:`Mat3`."""
+    return (
+        (matrix[0, 0], matrix[0, 1], matrix[0, 2]),
+        (matrix[1, 0], matrix[1, 1], matrix[1, 2]),
+        (matrix[2, 0], matrix[2, 1], matrix[2, 2]),
+    )
+
+
+@jit
 def solve(matrix: np.ndarray, rhs) -> Vec3:
-    """The solution x of the 3×3 system ``matrix · x = rhs``, by Cramer's rule: the adjugate
-    times ``rhs`` (rows as in :func:`matvec`), divided by the determinant."""
-    a = matrix
-    c00 = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
-    c01 = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
-    c02 = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
-    det = a[0, 0] * c00 + a[0, 1] * c01 + a[0, 2] * c02
-    c10 = a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]
-    c11 = a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]
-    c12 = a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]
-    c20 = a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]
-    c21 = a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]
-    c22 = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
+    """The solution x of the 3×3 system ``matrix · x = rhs`` (:func:`solve_rows`)."""
+    return solve_rows(rows(matrix), rhs)
+
+
+@jit
+def solve_rows(a, rhs) -> Vec3:
+    """The solution x of the 3×3 system ``a · x = rhs`` for ``a`` given by its rows (a
+    :data:`Mat3`), by Cramer's rule: the adjugate times ``rhs`` (rows as in :func:`matvec`),
+    divided by the determinant."""
+    c00 = a[1][1] * a[2][2] - a[1][2] * a[2][1]
+    c01 = a[1][2] * a[2][0] - a[1][0] * a[2][2]
+    c02 = a[1][0] * a[2][1] - a[1][1] * a[2][0]
+    det = a[0][0] * c00 + a[0][1] * c01 + a[0][2] * c02
+    c10 = a[0][2] * a[2][1] - a[0][1] * a[2][2]
+    c11 = a[0][0] * a[2][2] - a[0][2] * a[2][0]
+    c12 = a[0][1] * a[2][0] - a[0][0] * a[2][1]
+    c20 = a[0][1] * a[1][2] - a[0][2] * a[1][1]
+    c21 = a[0][2] * a[1][0] - a[0][0] * a[1][2]
+    c22 = a[0][0] * a[1][1] - a[0][1] * a[1][0]
     r0, r1, r2 = rhs[0], rhs[1], rhs[2]
     return (
         fused_multiply_add(c20, r2, fused_multiply_add(c00, r0, c10 * r1)) / det,
@@ -204,4 +220,130 @@ def matvec_transposed_from_zero(rows, vector) -> Vec3:
         column_dot_from_zero(rows, 0, vector),
         column_dot_from_zero(rows, 1, vector),
         column_dot_from_zero(rows, 2, vector),
+    )
+
+
+@jit
+def rows_matvec(rows, vector) -> Vec3:
+    """``matrix @ vector`` for a 3×3 matrix given by its rows (a :data:`Mat3`), each entry
+    ``fma(m_2 v_2, fma(m_0 v_0, m_1 v_1))``: the value :func:`matvec` (OpenBLAS's ``dgemv``)
+    returns for the same matrix as a C-ordered array."""
+    return (
+        fused_multiply_add(
+            rows[0][2], vector[2], fused_multiply_add(rows[0][0], vector[0], rows[0][1] * vector[1])
+        ),
+        fused_multiply_add(
+            rows[1][2], vector[2], fused_multiply_add(rows[1][0], vector[0], rows[1][1] * vector[1])
+        ),
+        fused_multiply_add(
+            rows[2][2], vector[2], fused_multiply_add(rows[2][0], vector[0], rows[2][1] * vector[1])
+        ),
+    )
+
+
+@jit
+def rows_matvec_transposed(rows, vector) -> Vec3:
+    """``matrix.T @ vector`` for a 3×3 matrix given by its rows (a :data:`Mat3`), each entry
+    ``fma(m_2j v_2, fma(m_1j v_1, m_0j v_0))``: the value :func:`matvec_transposed` returns
+    for the same matrix as a C-ordered array."""
+    return (
+        fused_multiply_add(
+            rows[2][0], vector[2], fused_multiply_add(rows[1][0], vector[1], rows[0][0] * vector[0])
+        ),
+        fused_multiply_add(
+            rows[2][1], vector[2], fused_multiply_add(rows[1][1], vector[1], rows[0][1] * vector[0])
+        ),
+        fused_multiply_add(
+            rows[2][2], vector[2], fused_multiply_add(rows[1][2], vector[1], rows[0][2] * vector[0])
+        ),
+    )
+
+
+@jit
+def transpose(rows) -> Mat3:
+    """The transpose of a 3×3 matrix given by its rows, as a :data:`Mat3`."""
+    return (
+        (rows[0][0], rows[1][0], rows[2][0]),
+        (rows[0][1], rows[1][1], rows[2][1]),
+        (rows[0][2], rows[1][2], rows[2][2]),
+    )
+
+
+@jit
+def _product_row(left_row, right) -> Vec3:
+    """Row ``left_row @ right`` with each entry the chain of
+    :func:`etsc_envs.core.linalg.fused_matmul`: ``fma(l_2, r_2j, fma(l_1, r_1j, l_0 r_0j))``."""
+    return (
+        fused_multiply_add(
+            left_row[2],
+            right[2][0],
+            fused_multiply_add(left_row[1], right[1][0], left_row[0] * right[0][0]),
+        ),
+        fused_multiply_add(
+            left_row[2],
+            right[2][1],
+            fused_multiply_add(left_row[1], right[1][1], left_row[0] * right[0][1]),
+        ),
+        fused_multiply_add(
+            left_row[2],
+            right[2][2],
+            fused_multiply_add(left_row[1], right[1][2], left_row[0] * right[0][2]),
+        ),
+    )
+
+
+@jit
+def product(left, right) -> Mat3:
+    """``left @ right`` for 3×3 matrices given by their rows: bit for bit the value of
+    :func:`etsc_envs.core.linalg.fused_matmul` (OpenBLAS's ``dgemm``) on the same matrices."""
+    return (
+        _product_row(left[0], right),
+        _product_row(left[1], right),
+        _product_row(left[2], right),
+    )
+
+
+@jit
+def rows_add(a, b) -> Mat3:
+    """``a + b`` for 3×3 matrices given by their rows."""
+    return (add(a[0], b[0]), add(a[1], b[1]), add(a[2], b[2]))
+
+
+@jit
+def rows_scale(factor: float, a) -> Mat3:
+    """``factor * a`` for a scalar ``factor`` and a 3×3 matrix given by its rows."""
+    return (scale(factor, a[0]), scale(factor, a[1]), scale(factor, a[2]))
+
+
+@jit
+def rows_divide(a, divisor: float) -> Mat3:
+    """``a / divisor`` for a 3×3 matrix given by its rows and a scalar ``divisor``."""
+    return (
+        (a[0][0] / divisor, a[0][1] / divisor, a[0][2] / divisor),
+        (a[1][0] / divisor, a[1][1] / divisor, a[1][2] / divisor),
+        (a[2][0] / divisor, a[2][1] / divisor, a[2][2] / divisor),
+    )
+
+
+@jit
+def rows_negate(a) -> Mat3:
+    """``-a`` for a 3×3 matrix given by its rows."""
+    return (negate(a[0]), negate(a[1]), negate(a[2]))
+
+
+@jit
+def rows_matvec_chain(rows, vector) -> Vec3:
+    """``matrix @ vector`` for a 3×3 matrix given by its rows, each entry the chain
+    ``fma(m_2 v_2, fma(m_1 v_1, m_0 v_0))`` of :func:`etsc_envs.core.linalg.fused_matmul` (a
+    column of a matrix product; :func:`rows_matvec` is OpenBLAS's ``dgemv`` order instead)."""
+    return (
+        fused_multiply_add(
+            rows[0][2], vector[2], fused_multiply_add(rows[0][1], vector[1], rows[0][0] * vector[0])
+        ),
+        fused_multiply_add(
+            rows[1][2], vector[2], fused_multiply_add(rows[1][1], vector[1], rows[1][0] * vector[0])
+        ),
+        fused_multiply_add(
+            rows[2][2], vector[2], fused_multiply_add(rows[2][1], vector[1], rows[2][0] * vector[0])
+        ),
     )

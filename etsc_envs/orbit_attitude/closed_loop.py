@@ -20,32 +20,37 @@ from collections import namedtuple
 
 import numpy as np
 
+from etsc_envs.core import vec3
 from etsc_envs.core.compiled_loop import ProblemKernels, always_accepts, stored_features
 from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import fused_dot
-from etsc_envs.core.rotations import se3_log
+from etsc_envs.core.linalg import as_array, fused_dot
+from etsc_envs.core.rotations import attitude_rows, se3_log_parts
 from etsc_envs.orbit_attitude.controller import (
     ControllerGains,
-    adaptive_denominator,
+    adaptive_denominator_of,
     adaptive_derivative,
-    adaptive_gain,
-    block_norms,
+    adaptive_gain_of,
+    block_norms_of,
     control_law,
     eso_derivative,
     eso_input,
     fixed_gain_feedback,
     inertia_solve,
+    inertia_solve_of,
     inertia_times,
-    known_dynamics,
+    inertia_times_of,
+    known_dynamics_of,
     sliding_surface,
     surface_drift,
 )
 from etsc_envs.orbit_attitude.dynamics import (
     LeaderOrbit,
     PlantModel,
-    error_pose,
+    plant_terms,
+    plant_time_terms,
     relative_derivative,
+    relative_rate,
     thruster_outputs,
 )
 
@@ -100,46 +105,63 @@ LoopConstants = namedtuple(
 """What every episode shares; the leader's angles, the disturbance phases and ΔD of the
 episode are taken from the state row (:func:`episode_model`, :func:`episode_gains`)."""
 
-integrate_plant = make_rk4_step(relative_derivative)
+integrate_plant = make_rk4_step(relative_rate, plant_time_terms)
+
+
+@jit
+def controller_terms(t: float, y: np.ndarray, c: np.ndarray, gains: ControllerGains):
+    """What the controller computes at ``t`` from the measured g_e, Ṽ and its own state ``c``,
+    as 6-tuples (see :func:`controller_view`)."""
+    rotation_e = vec3.transpose(attitude_rows(y[0:4]))  # g_e = [[R_e, r_e], [0, 1]]
+    position_e = y[4:7]
+    twist_error = y[7:13]
+    phi, chi = se3_log_parts(rotation_e, position_e)
+    eta = (phi[0], phi[1], phi[2], chi[0], chi[1], chi[2])
+    known = known_dynamics_of(t, rotation_e, position_e, twist_error, gains)
+    surface = sliding_surface(eta, twist_error, gains)
+    drift = surface_drift(known, eta, twist_error, gains)
+    z2 = c[6:12]
+    phi_hat = c[12:14]
+    fixed_gain = fixed_gain_feedback(drift, z2, surface, gains)
+    denominator = adaptive_denominator_of(block_norms_of(surface), t, gains)
+    integral = c[14:16]
+    command = control_law(
+        fixed_gain, surface, adaptive_gain_of(phi_hat, integral, denominator, gains)
+    )
+    restarted = adaptive_gain_of(phi_hat, (0.0, 0.0), denominator, gains)
+    fresh = control_law(fixed_gain, surface, restarted)
+    return eta, surface, drift, known, command, fresh
 
 
 @jit
 def controller_view(t: float, y: np.ndarray, c: np.ndarray, gains: ControllerGains):
     """What the controller computes at ``t`` from the measured g_e, Ṽ and its own state ``c``.
 
-    Returns ``(η̃, S, H1, H + Ξ⁻¹f(Ξ), Γ_cout, Γ_cout at a transmission)``. ``Γ_cout`` uses the
-    integral of eq. (23) accumulated since the last transmission (what the trigger compares
-    with the held command); a transmission at ``t`` restarts that integral, so the command it
-    sends is the second one, with the integral at zero.
+    Returns ``(η̃, S, H1, H + Ξ⁻¹f(Ξ), Γ_cout, Γ_cout at a transmission)`` as arrays.
+    ``Γ_cout`` uses the integral of eq. (23) accumulated since the last transmission (what the
+    trigger compares with the held command); a transmission at ``t`` restarts that integral, so
+    the command it sends is the second one, with the integral at zero.
     """
-    g_e = error_pose(y)
-    twist_error = np.ascontiguousarray(y[7:13])
-    eta = se3_log(g_e)
-    known = known_dynamics(t, g_e, twist_error, gains)
-    surface = sliding_surface(eta, twist_error, gains)
-    drift = surface_drift(known, eta, twist_error, gains)
-    z2 = c[6:12]
-    phi_hat = c[12:14]
-    fixed_gain = fixed_gain_feedback(drift, z2, surface, gains)
-    denominator = adaptive_denominator(block_norms(surface), t, gains)
-    integral = c[14:16]
-    command = control_law(fixed_gain, surface, adaptive_gain(phi_hat, integral, denominator, gains))
-    restarted = adaptive_gain(phi_hat, np.zeros(2), denominator, gains)
-    fresh = control_law(fixed_gain, surface, restarted)
-    return eta, surface, drift, known, command, fresh
+    eta, surface, drift, known, command, fresh = controller_terms(t, y, c, gains)
+    return (
+        as_array(eta),
+        as_array(surface),
+        as_array(drift),
+        as_array(known),
+        as_array(command),
+        as_array(fresh),
+    )
 
 
 @jit
-def observation_features(
-    eta: np.ndarray, surface: np.ndarray, y: np.ndarray, held: np.ndarray, command: np.ndarray
-) -> np.ndarray:
-    """``[e_c (6), S (6), η̃ (6), Ṽ (6)]`` with ``e_c = Γ_c - Γ_cout`` (eq. 21's inputs)."""
-    features = np.empty(N_FEATURES)
-    features[0:6] = held - command
-    features[6:12] = surface
-    features[12:18] = eta
-    features[18:24] = y[7:13]
-    return features
+def store_features(out: np.ndarray, eta, surface, y: np.ndarray, held: np.ndarray, command) -> None:
+    """Write ``[e_c (6), S (6), η̃ (6), Ṽ (6)]`` with ``e_c = Γ_c - Γ_cout`` (eq. 21's inputs)
+    into ``out``."""
+    for i in range(6):
+        out[i] = held[i] - command[i]
+        out[6 + i] = surface[i]
+        out[12 + i] = eta[i]
+        out[18 + i] = y[7 + i]
 
 
 @jit
@@ -148,7 +170,7 @@ def total_disturbance(
     y: np.ndarray,
     wrench: np.ndarray,
     fed: np.ndarray,
-    known: np.ndarray,
+    known,
     model: PlantModel,
     gains: ControllerGains,
 ) -> np.ndarray:
@@ -158,8 +180,12 @@ def total_disturbance(
     what the ESO is fed for it (:func:`~etsc_envs.orbit_attitude.controller.eso_input`), so Δd
     is exactly the extended state Z2 the ESO estimates.
     """
-    true_rate = relative_derivative(t, y, (wrench, model))[7:13]
-    return true_rate - known - inertia_solve(fed, gains)
+    true_rate = relative_derivative(t, y, (wrench, model))
+    solved = inertia_solve_of(fed, gains)
+    out = np.empty(6)
+    for i in range(6):
+        out[i] = (true_rate[7 + i] - known[i]) - solved[i]
+    return out
 
 
 @jit
@@ -182,10 +208,11 @@ def disturbance_step(
 
 
 @jit
-def abs_max(x: np.ndarray) -> float:
-    """``np.abs(x).max()`` without the temporary: the largest |x_i|, or the first NaN."""
+def abs_max(x) -> float:
+    """``np.abs(x).max()`` without the temporary: the largest |x_i| (an array or a tuple), or
+    the first NaN."""
     largest = np.abs(x[0])
-    for i in range(x.size):
+    for i in range(len(x)):
         value = np.abs(x[i])
         if np.isnan(value):
             return value
@@ -206,98 +233,113 @@ def all_finite(x: np.ndarray) -> bool:
 
 
 @jit
-def tracking_cost(eta: np.ndarray, twist_error: np.ndarray, reference: np.ndarray) -> float:
-    """Per-step accuracy cost ``¼ Σ_j log(1 + ‖x_j‖ / ref_j)`` for x = Φ, Δω, χ, Δv."""
-    cost = np.log1p(np.sqrt(fused_dot(eta[0:3], eta[0:3])) / reference[0])
-    cost += np.log1p(np.sqrt(fused_dot(twist_error[0:3], twist_error[0:3])) / reference[1])
-    cost += np.log1p(np.sqrt(fused_dot(eta[3:6], eta[3:6])) / reference[2])
-    cost += np.log1p(np.sqrt(fused_dot(twist_error[3:6], twist_error[3:6])) / reference[3])
+def tracking_cost(eta, twist_error, reference: np.ndarray) -> float:
+    """Per-step accuracy cost ``¼ Σ_j log(1 + ‖x_j‖ / ref_j)`` for x = Φ, Δω, χ, Δv (η̃ and Ṽ
+    as arrays or tuples)."""
+    cost = np.log1p(np.sqrt(vec3.dot(eta[0:3], eta[0:3])) / reference[0])
+    cost += np.log1p(np.sqrt(vec3.dot(twist_error[0:3], twist_error[0:3])) / reference[1])
+    cost += np.log1p(np.sqrt(vec3.dot(eta[3:6], eta[3:6])) / reference[2])
+    cost += np.log1p(np.sqrt(vec3.dot(twist_error[3:6], twist_error[3:6])) / reference[3])
     return 0.25 * cost
 
 
 @jit
 def closed_loop_step(
+    state: np.ndarray,
     t: float,
     h: float,
     substeps: int,
-    y: np.ndarray,
-    c: np.ndarray,
     held: np.ndarray,
-    response: tuple,
     model: PlantModel,
     gains: ControllerGains,
-    view: np.ndarray,
     cost_reference: np.ndarray,
     with_disturbance: bool,
-):
-    """Advance plant and controller from t to t + h with the held command ``held``.
+) -> float:
+    """Advance plant and controller in the state row from t to t + h with the held command
+    ``held``, and return the step's :func:`tracking_cost` at t + h.
 
-    ``response = (u_a, Γ_actual, fed)`` is what the thrusters and the ESO make of ``held``
-    (:func:`hold_command`). ``view = [S(t), H1(t)]`` is what the controller evaluated at t
-    (returned by the previous step, or :func:`initial_view`). Returns ``(y_next, c_next,
-    fresh_command, features, view_next, cost, diagnostics)``: the states at t + h, the command
-    a transmission at t + h would send, the observation features and ``[S, H1]`` there, the
-    step's :func:`tracking_cost` at t + h, and the :data:`N_DIAGNOSTICS` summary (its maxima of
-    the ESO errors ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at t + h, Δd with the command held over
-    the period just simulated, are computed only if ``with_disturbance``, else zero).
+    The row's ``THRUSTER_OUTPUT``, ``HELD_WRENCH`` and ``HELD_FED`` are what the thrusters and
+    the ESO make of ``held`` (:func:`hold_command`), its ``VIEW = [S(t), H1(t)]`` what the
+    controller evaluated at t. The step writes the states at t + h (``PLANT``, ``CONTROLLER``),
+    the command a transmission at t + h would send (``COMMAND``), the observation features and
+    ``[S, H1]`` there (``FEATURES``, ``VIEW``) and the :data:`N_DIAGNOSTICS` summary
+    (``DIAGNOSTICS``; its maxima of the ESO errors ``e1 = Ẑ1 - S`` and ``e2 = Ẑ2 - Δd`` at
+    t + h, Δd with the command held over the period just simulated, are computed only if
+    ``with_disturbance``, else zero).
     """
     # controller at t: ESO, adaptive law and the integral of eq. (23), forward Euler
-    surface = view[0:6]
-    drift = view[6:12]
-    output, wrench, fed = response
-    dz1, dz2 = eso_derivative(c[0:6], c[6:12], surface, drift, fed, gains)
-    dphi = adaptive_derivative(c[12:14], surface, t, gains)
-    c_next = np.empty(16)
+    c = state[CONTROLLER]
+    view = state[VIEW]
+    output = state[THRUSTER_OUTPUT]
+    wrench = state[HELD_WRENCH]
+    fed = state[HELD_FED]
+    dz1, dz2 = eso_derivative(c[0:6], c[6:12], view[0:6], view[6:12], fed, gains)
+    dphi = adaptive_derivative(c[12:14], view[0:6], t, gains)
     for i in range(6):
-        c_next[i] = c[i] + h * dz1[i]
-        c_next[6 + i] = c[6 + i] + h * dz2[i]
+        c[i] = c[i] + h * dz1[i]
+        c[6 + i] = c[6 + i] + h * dz2[i]
     for j in range(2):
-        c_next[12 + j] = c[12 + j] + h * dphi[j]
-        c_next[14 + j] = c[14 + j] + h * c[12 + j]
+        c[14 + j] = c[14 + j] + h * c[12 + j]
+        c[12 + j] = c[12 + j] + h * dphi[j]
 
     # plant over [t, t + h) under the held command (ZOH at the thrusters)
-    y_next = y
+    y = state[PLANT]
     dt = h / substeps
+    plant = (
+        (wrench[0], wrench[1], wrench[2], wrench[3], wrench[4], wrench[5]),
+        plant_terms(model),
+    )
     for i in range(substeps):
-        y_next = integrate_plant(t + i * dt, y_next, dt, (wrench, model))
+        y_next = integrate_plant(t + i * dt, y, dt, plant)
         y_next[0:4] /= np.sqrt(fused_dot(y_next[0:4], y_next[0:4]))
+        y[:] = y_next
 
     # what the controller sees at t + h
     t_next = t + h
-    eta, surface, drift, known, command, fresh = controller_view(t_next, y_next, c_next, gains)
-    features = observation_features(eta, surface, y_next, held, command)
-    view_next = np.empty(12)
-    view_next[0:6] = surface
-    view_next[6:12] = drift
-    e1 = np.empty(6)
+    eta, surface, drift, known, command, fresh = controller_terms(t_next, y, c, gains)
+    features = state[FEATURES]
+    store_features(features, eta, surface, y, held, command)
+    fresh_command = state[COMMAND]
     for i in range(6):
-        e1[i] = c_next[i] - surface[i]
-    twist_error = y_next[7:13]
+        fresh_command[i] = fresh[i]
+        view[i] = surface[i]
+        view[6 + i] = drift[i]
+    twist_error = y[7:13]
     cost = tracking_cost(eta, twist_error, cost_reference)
-    diagnostics = np.empty(N_DIAGNOSTICS)
-    diagnostics[0] = np.sqrt(fused_dot(eta[0:3], eta[0:3]))
-    diagnostics[1] = np.sqrt(fused_dot(eta[3:6], eta[3:6]))
+    diagnostics = state[DIAGNOSTICS]
+    diagnostics[0] = np.sqrt(vec3.dot(eta[0:3], eta[0:3]))
+    diagnostics[1] = np.sqrt(vec3.dot(eta[3:6], eta[3:6]))
     diagnostics[2] = abs_max(eta[0:3])
     diagnostics[3] = abs_max(twist_error[0:3])
     diagnostics[4] = abs_max(eta[3:6])
     diagnostics[5] = abs_max(twist_error[3:6])
-    diagnostics[6] = abs_max(e1[0:3])
-    diagnostics[7] = abs_max(e1[3:6])
+    diagnostics[6] = abs_max((c[0] - surface[0], c[1] - surface[1], c[2] - surface[2]))
+    diagnostics[7] = abs_max((c[3] - surface[3], c[4] - surface[4], c[5] - surface[5]))
     diagnostics[8] = 0.0
     diagnostics[9] = 0.0
     if with_disturbance:
-        e2 = c_next[6:12] - total_disturbance(t_next, y_next, wrench, fed, known, model, gains)
-        e2_physical = inertia_times(e2, gains)
+        disturbance = total_disturbance(t_next, y, wrench, fed, known, model, gains)
+        e2_physical = inertia_times_of(
+            (
+                c[6] - disturbance[0],
+                c[7] - disturbance[1],
+                c[8] - disturbance[2],
+                c[9] - disturbance[3],
+                c[10] - disturbance[4],
+                c[11] - disturbance[5],
+            ),
+            gains,
+        )
         diagnostics[8] = abs_max(e2_physical[0:3])
         diagnostics[9] = abs_max(e2_physical[3:6])
     total_output = 0.0
     for i in range(output.size):
         total_output += np.abs(output[i])
     diagnostics[10] = h * total_output
-    diagnostics[11] = np.sqrt(fused_dot(twist_error[0:3], twist_error[0:3]))
-    diagnostics[12] = np.sqrt(fused_dot(twist_error[3:6], twist_error[3:6]))
-    diagnostics[13] = 1.0 if all_finite(y_next) and all_finite(features) else 0.0
-    return y_next, c_next, fresh, features, view_next, cost, diagnostics
+    diagnostics[11] = np.sqrt(vec3.dot(twist_error[0:3], twist_error[0:3]))
+    diagnostics[12] = np.sqrt(vec3.dot(twist_error[3:6], twist_error[3:6]))
+    diagnostics[13] = 1.0 if all_finite(y) and all_finite(features) else 0.0
+    return cost
 
 
 @jit
@@ -453,25 +495,14 @@ def advance_loop(
     gains = episode_gains(state, constants)
     if not holds(state, held[0]):
         hold_command(state, held[0], model, gains)
-    (
-        state[PLANT],
-        state[CONTROLLER],
-        state[COMMAND],
-        state[FEATURES],
-        state[VIEW],
-        channel_costs[0],
-        state[DIAGNOSTICS],
-    ) = closed_loop_step(
+    channel_costs[0] = closed_loop_step(
+        state,
         step_index * h,
         h,
         constants.plant_substeps,
-        state[PLANT],
-        state[CONTROLLER],
         held[0],
-        (state[THRUSTER_OUTPUT], state[HELD_WRENCH], state[HELD_FED]),
         model,
         gains,
-        state[VIEW],
         constants.cost_reference,
         steady,
     )

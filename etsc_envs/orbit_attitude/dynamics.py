@@ -36,8 +36,13 @@ import numpy as np
 
 from etsc_envs.core import vec3
 from etsc_envs.core.jit import jit
-from etsc_envs.core.linalg import fused_matmul
-from etsc_envs.core.rotations import attitude_matrix, cross, quat_rate
+from etsc_envs.core.rotations import (
+    IDENTITY_ROWS,
+    attitude_matrix,
+    attitude_rows,
+    cross,
+    quat_rate,
+)
 
 LeaderOrbit = namedtuple(
     "LeaderOrbit",
@@ -78,33 +83,81 @@ PlantModel = namedtuple(
 """Everything the true plant depends on, as arrays and scalars."""
 
 
+PlantTerms = namedtuple(
+    "PlantTerms",
+    [
+        "leader",
+        "earth_radius",
+        "j2",
+        "inertia",  # rows of J + ΔJ
+        "inertia_inv",
+        "mass",
+        "torque_offset",
+        "torque_amplitude",
+        "torque_frequency",
+        "torque_phase",
+        "force_offset",
+        "force_amplitude",
+        "force_frequency",
+        "force_phase",
+    ],
+)
+"""The fields of :class:`PlantModel` that the relative motion reads, as floats and tuples
+(:func:`plant_terms`): an RK4 step passes them to each stage's derivative without copying
+array structures or counting their references."""
+
+
+@jit
+def plant_terms(model: PlantModel) -> PlantTerms:
+    """The :class:`PlantTerms` of ``model``."""
+    return PlantTerms(
+        model.leader,
+        model.earth_radius,
+        model.j2,
+        vec3.rows(model.inertia),
+        vec3.rows(model.inertia_inv),
+        model.mass,
+        vec3.as_vec3(model.torque_offset),
+        vec3.as_vec3(model.torque_amplitude),
+        vec3.as_vec3(model.torque_frequency),
+        vec3.as_vec3(model.torque_phase),
+        vec3.as_vec3(model.force_offset),
+        vec3.as_vec3(model.force_amplitude),
+        model.force_frequency,
+        vec3.as_vec3(model.force_phase),
+    )
+
+
 # --------------------------------------------------------------------------- leader
 @jit
-def _rotation_z(angle: float) -> np.ndarray:
+def _rotation_z(angle: float) -> vec3.Mat3:
     c, s = np.cos(angle), np.sin(angle)
-    out = np.eye(3)
-    out[0, 0], out[0, 1], out[1, 0], out[1, 1] = c, -s, s, c
-    return out
+    return ((c, -s, 0.0), (s, c, 0.0), (0.0, 0.0, 1.0))
 
 
 @jit
-def _rotation_x(angle: float) -> np.ndarray:
+def _rotation_x(angle: float) -> vec3.Mat3:
     c, s = np.cos(angle), np.sin(angle)
-    out = np.eye(3)
-    out[1, 1], out[1, 2], out[2, 1], out[2, 2] = c, -s, s, c
-    return out
+    return ((1.0, 0.0, 0.0), (0.0, c, -s), (0.0, s, c))
+
+
+@jit
+def leader_rotation_rows(t: float, leader: LeaderOrbit) -> vec3.Mat3:
+    """R_d(t): leader body frame (= F_o: radial, along-track, normal) to ECI components, as the
+    tuple of its rows.
+
+    ``R_d = R_z(Ω) R_x(i) R_z(u(t))`` with the argument of latitude ``u = u(0) + n t``.
+    """
+    return vec3.product(
+        vec3.product(_rotation_z(leader.raan), _rotation_x(leader.inclination)),
+        _rotation_z(leader.latitude_argument0 + leader.rate * t),
+    )
 
 
 @jit
 def leader_rotation(t: float, leader: LeaderOrbit) -> np.ndarray:
-    """R_d(t): leader body frame (= F_o: radial, along-track, normal) to ECI components.
-
-    ``R_d = R_z(Ω) R_x(i) R_z(u(t))`` with the argument of latitude ``u = u(0) + n t``.
-    """
-    return fused_matmul(
-        fused_matmul(_rotation_z(leader.raan), _rotation_x(leader.inclination)),
-        _rotation_z(leader.latitude_argument0 + leader.rate * t),
-    )
+    """R_d(t) (:func:`leader_rotation_rows`) as a 3×3 array."""
+    return vec3.to_matrix(leader_rotation_rows(t, leader))
 
 
 @jit
@@ -124,12 +177,10 @@ def leader_pose(t: float, leader: LeaderOrbit) -> np.ndarray:
 
 
 @jit
-def leader_twist(leader: LeaderOrbit) -> np.ndarray:
-    """V_d = [ω_d, v_d] = [0, 0, n, 0, n a, 0] in the leader's body frame (constant)."""
-    out = np.zeros(6)
-    out[2] = leader.rate
-    out[4] = leader.rate * leader.radius
-    return out
+def leader_twist_of(leader: LeaderOrbit) -> tuple:
+    """V_d = [ω_d, v_d] = [0, 0, n, 0, n a, 0] in the leader's body frame (constant), as a
+    6-tuple."""
+    return (0.0, 0.0, leader.rate, 0.0, leader.rate * leader.radius, 0.0)
 
 
 # --------------------------------------------------------------------------- gravity
@@ -170,12 +221,13 @@ def j2_acceleration(position, mu: float, earth_radius: float, j2: float) -> vec3
 
 
 @jit
-def gravity_gradient_torque(position_body, inertia: np.ndarray, mu: float) -> vec3.Vec3:
-    """M_G = 3 μ/‖r‖⁵ (Rᵀr) × J (Rᵀr), with the position given in body components (Rᵀr)."""
+def gravity_gradient_torque(position_body, inertia, mu: float) -> vec3.Vec3:
+    """M_G = 3 μ/‖r‖⁵ (Rᵀr) × J (Rᵀr), with the position given in body components (Rᵀr) and J
+    by its rows (an array or a :data:`~etsc_envs.core.vec3.Mat3`)."""
     r2 = vec3.dot(position_body, position_body)
     return vec3.scale(
         3.0 * mu / (r2 * r2 * np.sqrt(r2)),
-        vec3.cross(position_body, vec3.matvec(inertia, position_body)),
+        vec3.cross(position_body, vec3.rows_matvec(inertia, position_body)),
     )
 
 
@@ -221,65 +273,86 @@ def thruster_outputs(command: np.ndarray, model: PlantModel):
 
 # --------------------------------------------------------------------------- relative motion
 @jit
-def relative_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
-    """ẏ for ``y = [q_e, r_e, Δω, Δv]`` under the body-frame thruster wrench ``args[0]``.
+def plant_time_terms(t: float, args):
+    """What :func:`relative_rate` needs of the time t: ``(R_d(t), d_τ(t), d_f(t))`` (R_d as
+    rows; the identity, unused, without the J2 term). ``args = (wrench, terms)``, ``terms`` the
+    :class:`PlantTerms`."""
+    model = args[1]
+    rotation_d = leader_rotation_rows(t, model.leader) if model.j2 != 0.0 else IDENTITY_ROWS
+    return rotation_d, disturbance_torque(t, model), disturbance_force(t, model)
 
-    ``args = (wrench, model)``; the wrench is held constant over the sampling period (ZOH of
-    the thruster commands). See the module docstring for the equations.
+
+@jit
+def relative_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
+    """ẏ for ``y = [q_e, r_e, Δω, Δv]`` at time t under the body-frame thruster wrench
+    ``args[0]`` of the plant ``args[1]`` (a :class:`PlantModel`; :func:`relative_rate`)."""
+    wrench, model = args
+    terms = (wrench, plant_terms(model))
+    return relative_rate(plant_time_terms(t, terms), y, terms)
+
+
+@jit
+def relative_rate(time_terms, y: np.ndarray, args) -> np.ndarray:
+    """ẏ for ``y = [q_e, r_e, Δω, Δv]`` under the body-frame thruster wrench ``args[0]``, with
+    the time-dependent terms ``time_terms`` of :func:`plant_time_terms`.
+
+    ``args = (wrench, terms)``, ``terms`` the plant's :class:`PlantTerms`; the wrench is held
+    constant over the sampling period (ZOH of the thruster commands). See the module docstring
+    for the equations.
     """
     wrench, model = args
+    rotation_d, torque_disturbance, force_disturbance = time_terms
     leader = model.leader
     q = y[0:4]
     offset = y[4:7]
     rate_error = y[7:10]
     velocity_error = y[10:13]
-    to_body = attitude_matrix(q)  # R_eᵀ
+    to_body = attitude_rows(q)  # R_eᵀ
     leader_rate = (0.0, 0.0, leader.rate)
-    leader_rate_body = vec3.matvec(to_body, leader_rate)  # R_eᵀ ω_d
+    leader_rate_body = vec3.rows_matvec(to_body, leader_rate)  # R_eᵀ ω_d
 
     # rotation: J ω̇ = -ω × Jω + M_G + τ + d_τ, then Δω̇ = ω̇ + Δω × R_eᵀω_d (ω̇_d = 0)
     omega = vec3.add(rate_error, leader_rate_body)
     position_leader = (offset[0] + leader.radius, offset[1], offset[2])
-    position_body = vec3.matvec(to_body, position_leader)
+    position_body = vec3.rows_matvec(to_body, position_leader)
     torque = vec3.subtract(
         vec3.add(
             vec3.add(wrench[0:3], gravity_gradient_torque(position_body, model.inertia, leader.mu)),
-            disturbance_torque(t, model),
+            torque_disturbance,
         ),
-        vec3.cross(omega, vec3.matvec(model.inertia, omega)),
+        vec3.cross(omega, vec3.rows_matvec(model.inertia, omega)),
     )
     rate_error_dot = vec3.add(
-        vec3.matvec(model.inertia_inv, torque), vec3.cross(rate_error, leader_rate_body)
+        vec3.rows_matvec(model.inertia_inv, torque), vec3.cross(rate_error, leader_rate_body)
     )
 
     # translation: Coriolis, centrifugal, differential gravity, forces
     gravity_leader = kepler_gravity_difference(offset, leader.radius, leader.mu)
     if model.j2 != 0.0:
-        rotation_d = leader_rotation(t, leader)
-        position_eci = vec3.matvec(rotation_d, position_leader)
+        position_eci = vec3.rows_matvec(rotation_d, position_leader)
         gravity_leader = vec3.add(
             gravity_leader,
-            vec3.matvec_transposed(
+            vec3.rows_matvec_transposed(
                 rotation_d, j2_acceleration(position_eci, leader.mu, model.earth_radius, model.j2)
             ),
         )
     centrifugal = vec3.negate(vec3.cross(leader_rate, vec3.cross(leader_rate, offset)))
-    force = vec3.add(wrench[3:6], disturbance_force(t, model))
+    force = vec3.add(wrench[3:6], force_disturbance)
     velocity_error_dot = vec3.add(
         vec3.add(
             vec3.subtract(
                 vec3.negate(vec3.cross(rate_error, velocity_error)),
                 vec3.scale(2.0, vec3.cross(leader_rate_body, velocity_error)),
             ),
-            vec3.matvec(to_body, vec3.add(centrifugal, gravity_leader)),
+            vec3.rows_matvec(to_body, vec3.add(centrifugal, gravity_leader)),
         ),
         vec3.divide(force, (model.mass, model.mass, model.mass)),
     )
 
     attitude_rate = quat_rate(q, rate_error)
-    # R_e Δv with the row kernel on a transposed copy: vec3.matvec_transposed sums in another
+    # R_e Δv with the row kernel on the transpose: vec3.rows_matvec_transposed sums in another
     # order (dgemv's on a transposed view) and would change the last bits
-    offset_rate = vec3.matvec(np.ascontiguousarray(to_body.T), velocity_error)
+    offset_rate = vec3.rows_matvec(vec3.transpose(to_body), velocity_error)
     dy = np.empty(13)
     for i in range(4):
         dy[i] = attitude_rate[i]
