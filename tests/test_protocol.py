@@ -247,7 +247,7 @@ def test_evaluate_runs_a_scenario_set_and_prints_the_aggregates_as_json() -> Non
     ("args", "message"),
     [
         (("--scenarios", "train"), "invalid choice: 'train'"),
-        (("--scenarios", "test", "--set-size", "0"), "size of a scenario set"),
+        (("--scenarios", "test", "--set-size", "0"), "argument --set-size: takes an integer >= 1"),
         (("--scenarios", "test", "--env-arg", "randomize=false"), "contradicts"),
     ],
 )
