@@ -347,7 +347,10 @@ def run_search(
     import cma
     import gymnasium as gym
 
-    env = gym.make(config.env_id, **config.env_args(training=True))
+    import etsc_envs
+
+    loop_id = etsc_envs.PETTINGZOO_LOOP_IDS.get(config.env_id, config.env_id)
+    env = gym.make(loop_id, **config.env_args(training=True))  # the horizon in instants
     n_steps = env.unwrapped.n_steps
     env.close()
     modulation = None
