@@ -73,14 +73,14 @@ def search_evaluations(folder: Path) -> list[dict[str, Any]]:
     from baselines.evaluate import evaluate
 
     config = load_config(folder / "config.yaml")
-    paper = evaluate(
+    evaluated = evaluate(
         config.env_id,
         "paper",
         env_args=config.env_args(training=False),
         scenarios="validation",
         set_size=config.validation_size,
-    )["mean"]
-    paper = {**paper, "failures": 0}
+    )
+    paper = {**evaluated["mean"], "failures": evaluated["aggregates"]["failure"]["count"]}
     evaluations = []
     for line in (folder / "generations.jsonl").read_text(encoding="utf-8").splitlines():
         record = json.loads(line)

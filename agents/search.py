@@ -48,9 +48,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import yaml
 
+import etsc_envs
 from etsc_envs.core.files import atomic_write_text, output_folder_argument
 from etsc_envs.protocol import require_training_seeds, scenario_set
 from etsc_envs.triggers import FAMILY_CLASSES, PAPER_TRIGGERS
@@ -238,25 +240,15 @@ def score(
     JSON form) over one episode per seed, all seeds in one batch
     (:func:`baselines.batch.run_batch`). A module-level function, so that worker processes and
     Ray tasks can run it."""
-    import gymnasium as gym
-
-    import etsc_envs
     from baselines.batch import run_batch
 
-    trigger_file = LearnedTrigger.from_json(learned)
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        env = etsc_envs.make_parallel(env_id, **env_args)
-        agent = env.possible_agents[0]
-        spaces = (env.observation_space(agent), env.action_space(agent))
-        names = tuple(env.unwrapped.agent_observation_names)
-        period = env.unwrapped.loop.sampling_period_s
-    else:
-        env = gym.make(env_id, **env_args)
-        spaces = (env.observation_space, env.action_space)
-        names = tuple(env.unwrapped.observation_names)
-        period = env.unwrapped.sampling_period_s
+    env = (
+        etsc_envs.make_parallel(env_id, **env_args)
+        if env_id in etsc_envs.PETTINGZOO_ENV_IDS
+        else gym.make(env_id, **env_args)
+    )
+    trigger = LearnedTrigger.from_json(learned).policy_for(env)
     env.close()
-    trigger = trigger_file.trigger(*spaces, names, period)
     records = run_batch(env_id, trigger, seeds, env_args)
     return {
         "return": float(np.mean([r["return"] for r in records])),
@@ -307,14 +299,9 @@ def training_seeds(config: SearchConfig, generation: int) -> list[int]:
 def observation_statistics(config: SearchConfig) -> tuple[np.ndarray, np.ndarray]:
     """Mean and spread of the network's inputs over two training episodes of the start point
     (the normalisation the learned file carries); a constant input gets spread 1."""
-    import gymnasium as gym
-
     env = gym.make(config.env_id, randomize=True, **config.env_args(training=True))
-    loop = env.unwrapped
-    names = loop.observation_names
-    trigger = LearnedTrigger(config.env_id, config.family.__name__, config.start).trigger(
-        env.observation_space, env.action_space, names, loop.sampling_period_s
-    )
+    names = env.unwrapped.observation_names
+    trigger = LearnedTrigger(config.env_id, config.family.__name__, config.start).policy_for(env)
     columns = [names.index(name) for name in config.inputs]
     rows = []
     for seed in training_seeds(config, 0)[:2]:
@@ -345,9 +332,6 @@ def run_search(
     """The search of the module docstring into ``out``, continuing the generations already
     recorded in ``out/generations.jsonl``; returns the learned trigger."""
     import cma
-    import gymnasium as gym
-
-    import etsc_envs
 
     loop_id = etsc_envs.PETTINGZOO_LOOP_IDS.get(config.env_id, config.env_id)
     env = gym.make(loop_id, **config.env_args(training=True))  # the horizon in instants

@@ -115,17 +115,7 @@ def load_policy(path: str, env: Any) -> Any:
             f"path: load_policy reads learned triggers (.json), got {path!r}; SB3 zips load "
             "with baselines.policies.load_sb3 in the checkout"
         )
-    learned = LearnedTrigger.load(path)
-    if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
-        agent = env.possible_agents[0]
-        spaces = (env.observation_space(agent), env.action_space(agent))
-        names = tuple(env.unwrapped.agent_observation_names)
-        period = env.unwrapped.loop.sampling_period_s
-    else:
-        spaces = (env.observation_space, env.action_space)
-        names = tuple(env.unwrapped.observation_names)
-        period = env.unwrapped.sampling_period_s
-    return learned.trigger(*spaces, names, period)
+    return LearnedTrigger.load(path).policy_for(env)
 
 
 __version__ = "0.1.0"

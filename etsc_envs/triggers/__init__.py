@@ -36,7 +36,6 @@ from etsc_envs.triggers.inner_formation import (
     InnerFormationShield,
     InnerFormationTrigger,
     default_error_time_thresholds,
-    default_thresholds,
 )
 from etsc_envs.triggers.orbit_attitude import PAPER_GAMMA, OrbitAttitudeTrigger
 
@@ -51,17 +50,12 @@ PAPER_TRIGGERS = {
 """Environment id → the paper's trigger policy class."""
 
 
-def _inner_formation_thresholds() -> dict[str, float]:
-    pi1, pi2, pi3 = default_thresholds()
-    return {"pi1": float(pi1), "pi2": float(pi2), "pi3": float(pi3)}
-
-
 PAPER_THRESHOLDS: dict[str, Callable[[], dict[str, float]]] = {
     "etsc/AttitudeTracking-v0": lambda: {"psi": PAPER_PSI},
     "etsc/OrbitAttitudeTracking-v0": lambda: {"gamma1": PAPER_GAMMA[0], "gamma2": PAPER_GAMMA[1]},
     "etsc/ClusterContainment-v0": lambda: {"c": PAPER_C},
     "etsc/ClusterContainmentCentral-v0": lambda: {"c": PAPER_C},
-    "etsc/InnerFormation-v0": _inner_formation_thresholds,
+    "etsc/InnerFormation-v0": InnerFormationTrigger.paper_thresholds,
     "etsc/AsteroidOrbitKeeping-v0": lambda: {"alpha": PAPER_ALPHA},
 }
 """Environment id → the keywords of its paper trigger that set how much error it tolerates

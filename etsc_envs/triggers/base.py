@@ -11,6 +11,7 @@ time-triggered references.
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -461,12 +462,15 @@ def timed_rule_class(
     return trigger_class, {}
 
 
-def instants_seconds(instants: int, sampling_period_s: float) -> float:
+def instants_seconds(instants: float, sampling_period_s: float) -> float:
     """The time since transmission that marks ``instants`` sampling instants: a channel that
     transmitted at instant k reaches it at instant k + ``instants`` (its time since
     transmission there is ``instants`` periods; half a period below, so float32 observations
-    compare safely). A floor or heartbeat of ``instants`` instants is this many seconds."""
-    return (int(instants) - 0.5) * float(sampling_period_s)
+    compare safely). A floor or heartbeat of ``instants`` instants is this many seconds; an
+    infinite count (no bound) stays infinite."""
+    if math.isinf(instants):
+        return math.inf
+    return (float(instants) - 0.5) * float(sampling_period_s)
 
 
 @jit

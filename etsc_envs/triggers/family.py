@@ -48,6 +48,7 @@ import numpy as np
 from etsc_envs.core.jit import closure_jit, jit
 from etsc_envs.triggers.base import (
     RuleTrigger,
+    instants_seconds,
     time_since_transmission_indices,
     transmit_bits,
 )
@@ -420,8 +421,8 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
             channels = 1 if transmit_bits(action_space) is None else transmit_bits(action_space)
             times = time_since_transmission_indices(names, channels)
             bounds = [
-                _seconds(point.floor_instants, period),
-                _seconds(point.heartbeat_instants, period),
+                instants_seconds(point.floor_instants, period),
+                instants_seconds(point.heartbeat_instants, period),
                 point.exponent,
                 REFERENCE_S[trigger_class.__name__],
                 0.5 * period if point.first_instant else 0.0,
@@ -460,12 +461,6 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
 
     FamilyTrigger.__name__ = FamilyTrigger.__qualname__ = f"{trigger_class.__name__}Family"
     return FamilyTrigger
-
-
-def _seconds(instants: float, period: float) -> float:
-    """A floor or heartbeat of ``instants`` sampling instants in seconds, as
-    :func:`~etsc_envs.triggers.base.instants_seconds` reckons it (``inf`` stays)."""
-    return math.inf if math.isinf(instants) else (instants - 0.5) * period
 
 
 @dataclass(frozen=True)
@@ -525,6 +520,21 @@ class LearnedTrigger:
             return cls.from_json(data)
         except (KeyError, TypeError, ValueError) as error:
             raise ValueError(f"learned:{path}: {error}") from None
+
+    def policy_for(self, env: Any) -> RuleTrigger:
+        """The trigger policy of this point for ``env``: a Gymnasium env of the suite, or a
+        PettingZoo parallel env (one policy for every agent, queried with their observations
+        stacked)."""
+        if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
+            agent = env.possible_agents[0]
+            spaces = (env.observation_space(agent), env.action_space(agent))
+            names = tuple(env.unwrapped.agent_observation_names)
+            period = env.unwrapped.loop.sampling_period_s
+        else:
+            spaces = (env.observation_space, env.action_space)
+            names = tuple(env.unwrapped.observation_names)
+            period = env.unwrapped.sampling_period_s
+        return self.trigger(*spaces, names, period)
 
     def trigger(
         self,
