@@ -29,6 +29,8 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from baselines.statistics import summarize
+
 Axes = Callable[[dict[str, Any]], tuple[float, float] | None]
 """A point's (transmissions, mean cost) on one scenario set, ``None`` where it failed there."""
 
@@ -192,8 +194,6 @@ def menu_verdict(
     cost, or :data:`COST_AT_EQUAL_TRANSMISSIONS_MAX` × the front's cost at its transmissions.
     Returns both ratios at the bounds (``None`` where the front does not reach the cost or the
     transmissions) and at the means, each seed's pair, and ``met`` (at the bounds)."""
-    from baselines.statistics import summarize
-
     front = envelope([pair for pair in map(axes, menu) if pair is not None])
     pairs = [pair for pair in map(axes, learned) if pair is not None]
     if not pairs or len(pairs) < len(learned):

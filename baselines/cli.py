@@ -120,7 +120,6 @@ def check_policy_arguments(spec: str, policy_args: dict[str, Any], env_id: str) 
 
 def make_policy(spec: str, env: gym.Env, policy_args: dict[str, Any], env_id: str) -> Any:
     """The policy named by ``spec`` (see :data:`POLICY_CHOICES`) for ``env``."""
-    check_policy_arguments(spec, policy_args, env_id)
     return _policy_for(
         spec,
         env.observation_space,
@@ -145,7 +144,6 @@ def make_agent_policy(spec: str, env: Any, policy_args: dict[str, Any], env_id: 
         for other in env.possible_agents
     ):
         raise ValueError(f"the agents of {env_id} differ in their spaces; no policy serves all")
-    check_policy_arguments(spec, policy_args, env_id)
     return _policy_for(
         spec,
         env.observation_space(agent),
@@ -237,6 +235,7 @@ def _policy_for(
     ``periodic`` is the counter-based :class:`PeriodicPolicy`. ``periodic`` with
     ``then_every`` and ``switch_after`` is :class:`SwitchedPeriodicPolicy` (every ``every``
     instants before instant ``switch_after``, every ``then_every`` after it)."""
+    check_policy_arguments(spec, policy_args, env_id)
     if spec == "always":
         return AlwaysPolicy(observation_space, action_space, **policy_args)
     if spec == "periodic":
