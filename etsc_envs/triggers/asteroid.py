@@ -9,7 +9,7 @@ import numpy as np
 
 from etsc_envs.core.jit import jit
 from etsc_envs.core.validation import require_positive
-from etsc_envs.triggers.base import RuleTrigger, condition_rule
+from etsc_envs.triggers.base import RuleTrigger
 
 PAPER_ALPHA = 0.05
 """α of eq. (15) in section 4, m²/s."""
@@ -56,7 +56,6 @@ class AsteroidOrbitKeepingTrigger(RuleTrigger):
         )
 
     condition = staticmethod(asteroid_condition)
-    rule = staticmethod(condition_rule(asteroid_condition, 1, False))
     threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"alpha": ("alpha",)}
 
     @classmethod

@@ -8,7 +8,7 @@ import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.triggers.base import RuleTrigger, condition_rule
+from etsc_envs.triggers.base import RuleTrigger
 
 PAPER_PSI = 0.1
 """Ψ of Tables 1-3's first event-triggered rows (the paper also runs 1.5 and 2.5)."""
@@ -54,7 +54,6 @@ class AttitudeTrackingTrigger(RuleTrigger):
 
     condition = staticmethod(attitude_tracking_condition)
     strict = True
-    rule = staticmethod(condition_rule(attitude_tracking_condition, 1, True))
     threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"psi": ("psi",)}
 
     @classmethod

@@ -142,9 +142,9 @@ class RuleTrigger(TriggerPolicy):
     rule: ClassVar[Callable[..., None]]
 
     condition: ClassVar[Callable[..., None] | None] = None
-    """A paper's condition as its two sides (see :func:`condition_rule`; ``rule`` is then
-    ``condition_rule(condition, conditions_per_channel, strict)``), or ``None`` for a rule
-    that is not a paper's (a clock)."""
+    """A paper's condition as its two sides (see :func:`condition_rule`), or ``None`` for a
+    rule that is not a paper's (a clock). A class that sets it gets ``rule =
+    condition_rule(condition, conditions_per_channel, strict)``."""
     conditions_per_channel: ClassVar[int] = 1
     strict: ClassVar[bool] = False
     threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {}
@@ -152,6 +152,12 @@ class RuleTrigger(TriggerPolicy):
     scale several keywords: Π for the three axes of paper 004)."""
     factor_bounds: ClassVar[dict[str, tuple[float, float]]] = {}
     """The factors' allowed ranges, where the paper bounds a threshold (others: (0, inf))."""
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "condition" in cls.__dict__ and cls.condition is not None:
+            rule = condition_rule(cls.condition, cls.conditions_per_channel, cls.strict)
+            cls.rule = staticmethod(rule)  # type: ignore[assignment]
 
     @classmethod
     def paper_thresholds(cls) -> dict[str, float]:

@@ -8,7 +8,7 @@ import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.triggers.base import RuleTrigger, condition_rule, transmit_bits
+from etsc_envs.triggers.base import RuleTrigger, transmit_bits
 
 PAPER_C, PAPER_RHO, PAPER_NU = 0.6, 2.0, 0.5
 """c_i, ρ_i, ν_i of section 5.1 (the same for every follower)."""
@@ -100,7 +100,6 @@ class ClusterContainmentTrigger(RuleTrigger):
         )
 
     condition = staticmethod(cluster_condition)
-    rule = staticmethod(condition_rule(cluster_condition, 1, False))
     threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"c": ("c",), "rho": ("rho",)}
     factor_bounds: ClassVar[dict[str, tuple[float, float]]] = {"c": (0.0, 1.0 / PAPER_C)}
 

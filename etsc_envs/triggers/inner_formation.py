@@ -13,7 +13,7 @@ from etsc_envs.core.jit import jit
 from etsc_envs.core.validation import require_positive
 from etsc_envs.inner_formation.design import equal_share_thresholds
 from etsc_envs.inner_formation.params import InnerFormationParams
-from etsc_envs.triggers.base import RuleTrigger, condition_rule
+from etsc_envs.triggers.base import RuleTrigger
 
 AXES = ("x", "y", "z")
 
@@ -89,7 +89,6 @@ class InnerFormationTrigger(RuleTrigger):
 
     condition = staticmethod(inner_formation_condition)
     strict = True
-    rule = staticmethod(condition_rule(inner_formation_condition, 1, True))
     threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"pi": ("pi1", "pi2", "pi3")}
 
     @classmethod

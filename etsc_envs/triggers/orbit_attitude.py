@@ -8,7 +8,7 @@ import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import jit
-from etsc_envs.triggers.base import RuleTrigger, condition_rule
+from etsc_envs.triggers.base import RuleTrigger
 
 PAPER_A = (0.6, 0.8)
 """a1, a2 of section IV (Theorem 2 needs K21 = 3.2 > a1 and K22 = 3.6 > a2)."""
@@ -82,7 +82,6 @@ class OrbitAttitudeTrigger(RuleTrigger):
 
     condition = staticmethod(orbit_attitude_condition)
     conditions_per_channel = 2
-    rule = staticmethod(condition_rule(orbit_attitude_condition, 2, False))
     threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {
         "gamma1": ("gamma1",),
         "gamma2": ("gamma2",),
