@@ -107,16 +107,21 @@ class SearchConfig:
         return args
 
 
-def load_config(path: str | Path) -> SearchConfig:
-    """The search config in the YAML file ``path``; ``ValueError`` naming the key for a bad
-    value."""
+def read_config(path: str | Path) -> dict[str, Any]:
+    """The mapping of keys in the YAML file ``path`` (``ValueError`` naming ``--config``)."""
     try:
         raw = yaml.safe_load(Path(path).read_text())
     except (OSError, yaml.YAMLError) as error:
         raise ValueError(f"--config {path}: {error}") from None
     if not isinstance(raw, dict):
         raise ValueError(f"--config {path}: a search config is a mapping of keys")
-    return config_from_dict(raw)
+    return raw
+
+
+def load_config(path: str | Path) -> SearchConfig:
+    """The search config in the YAML file ``path``; ``ValueError`` naming the key for a bad
+    value."""
+    return config_from_dict(read_config(path))
 
 
 def config_from_dict(raw: dict[str, Any]) -> SearchConfig:
@@ -512,7 +517,8 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        config = load_config(args.config)
+        raw = read_config(args.config)
+        config = config_from_dict(raw)
         if args.seed is not None:
             config = replace(config, seed=_integer("--seed", args.seed, 0))
         if args.processes is not None:
@@ -541,10 +547,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.overwrite and log_path.exists():
             log_path.unlink()
-        settings = yaml.safe_dump(
-            {**yaml.safe_load(Path(args.config).read_text()), "seed": config.seed}
-        )
-        atomic_write_text(out / "config.yaml", settings)
+        atomic_write_text(out / "config.yaml", yaml.safe_dump({**raw, "seed": config.seed}))
         processes = args.processes
         if processes is None and args.address is None and not os.environ.get("RAY_ADDRESS"):
             try:
