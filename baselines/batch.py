@@ -5,7 +5,7 @@ A set of ``K`` scenarios (seeds) runs as the ``K`` sub-environments of the id's 
 env (:mod:`etsc_envs.core.vector_env`), all stepped in one compiled call, and the policy is
 asked once per instant for the whole batch — for a PettingZoo id, once for every agent of
 every copy (``K × N`` observations, agent-minor, the layout of
-:class:`agents.vector_adapter.SharedPolicyVecEnv`). Sub-environment ``j`` reset with seed
+:class:`agents.train.vector_adapter.SharedPolicyVecEnv`). Sub-environment ``j`` reset with seed
 ``s_j`` is the single environment reset with ``s_j`` (the vector env's contract), so a
 scenario's record here equals :func:`baselines.episodes.run_episode`'s (or
 :func:`~baselines.episodes.run_parallel_episode`'s) for the same seed, key for key; only

@@ -294,7 +294,7 @@ NORMALIZATION_SUFFIX = "_vecnormalize.npz"
 ``allow_pickle=False``)."""
 LEGACY_NORMALIZATION_SUFFIX = "_vecnormalize.pkl"
 """Where earlier versions kept the statistics: SB3's pickled ``VecNormalize``, which is never
-unpickled here (``python -m agents.convert_statistics`` converts one after checking that it
+unpickled here (``python -m agents.train.convert_statistics`` converts one after checking that it
 holds nothing else)."""
 
 
@@ -528,7 +528,7 @@ def load_sb3(
         raise ValueError(
             f"observation statistics {legacy} (beside the model) are a pickle, which is not "
             f"loaded (it could run code); convert them once with: python -m "
-            f"agents.convert_statistics {legacy}"
+            f"agents.train.convert_statistics {legacy}"
         )
     normalization = ObservationStatistics.read(statistics) if statistics.is_file() else None
     if normalization is not None and normalization.observation_mean.shape != tuple(

@@ -37,7 +37,7 @@ An action of :class:`DecisionSet` is one of
 A multi-channel id (``MultiBinary``: 004, the central cluster) shares one interval: a hold
 sends every channel, the paper's rule sends the channels it names. :class:`IntervalSchedule`
 runs these semantics one instant at a time for a batch of rows; the training wrapper
-(:class:`agents.decisions.SelfTriggeredWrapper`) and the deployed transmit/hold policy
+(:class:`agents.train.decisions.SelfTriggeredWrapper`) and the deployed transmit/hold policy
 (:class:`SelfTriggeredPolicy`) both drive it, so they take the same decisions. Where the id has
 a shield (:data:`etsc_envs.triggers.PAPER_SHIELDS`) and a ``shield_multiple`` is set, unsafe
 actions are masked (:meth:`IntervalSchedule.masks`) and an unsafe choice is replaced by the

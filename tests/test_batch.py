@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from agents.evaluation import deployment
+from agents.train.validation_callback import deployment
 from baselines.batch import run_batch, run_batch_in_processes
 from baselines.cli import episode_setup
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.decisions import SelfTriggeredWrapper
+from agents.train.decisions import SelfTriggeredWrapper
 from baselines.cli import episode_setup
 from baselines.episodes import run_episode
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy, scaled_rule_trigger

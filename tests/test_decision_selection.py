@@ -1,5 +1,5 @@
 """Choosing the decision a self-triggered run starts from, per transmission penalty
-(``imitation_decision: best``, :mod:`agents.decision_selection`)."""
+(``imitation_decision: best``, :mod:`agents.train.decision_selection`)."""
 
 from __future__ import annotations
 
@@ -9,11 +9,15 @@ import pytest
 import yaml
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.config import config_from_dict
-from agents.decision_selection import constant_decision_policy, select_decision, stand_alone_spec
-from agents.evaluation import deployment, set_summary
-from agents.imitation import FixedDecision
-from agents.train import main
+from agents.train.config import config_from_dict
+from agents.train.decision_selection import (
+    constant_decision_policy,
+    select_decision,
+    stand_alone_spec,
+)
+from agents.train.imitation import FixedDecision
+from agents.train.training import main
+from agents.train.validation_callback import deployment, set_summary
 from baselines.batch import run_batch
 from baselines.cli import episode_setup
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy

@@ -12,7 +12,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.decisions import SelfTriggeredWrapper, interval_env
+from agents.train.decisions import SelfTriggeredWrapper, interval_env
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.evaluate import evaluate
@@ -385,7 +385,7 @@ def test_short_training_saves_reloads_and_evaluates(tmp_path, algorithm):
 def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
     import yaml
 
-    from agents.train import main
+    from agents.train.training import main
 
     out_dir = tmp_path / "run"
     config = {
@@ -452,7 +452,7 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
     ],
 )
 def test_training_config_checks_the_decisions(tmp_path, changes, message):
-    from agents.config import config_from_dict
+    from agents.train.config import config_from_dict
 
     config = {
         "env_id": FORMATION,
@@ -483,7 +483,7 @@ def train_cloned(tmp_path, **keys) -> tuple[Path, dict]:
     with ``keys`` replaced; the run's folder and its ``train_summary.json``."""
     import yaml
 
-    from agents.train import main
+    from agents.train.training import main
 
     out_dir = tmp_path / "run"
     config = {
@@ -578,7 +578,7 @@ def test_a_pinned_decision_is_the_policy_everywhere(tmp_path):
     import torch
     from stable_baselines3 import PPO
 
-    from agents.imitation import pin_decision
+    from agents.train.imitation import pin_decision
 
     env = SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.1), max_exponent=3)
     model = PPO("MlpPolicy", env, n_steps=32, batch_size=32, n_epochs=1, seed=0)
@@ -631,7 +631,7 @@ def test_agents_train_pins_the_cloned_decision(tmp_path):
 
 def test_the_decentralised_cluster_trains_pinned_and_deploys(tmp_path):
     """A PettingZoo id takes self-triggered decisions one follower at a time
-    (:class:`agents.follower_decisions.FollowerDecisionEnv`): a short pinned run completes,
+    (:class:`agents.train.follower_decisions.FollowerDecisionEnv`): a short pinned run completes,
     its teammates act as the model, and the saved model deploys through ``sb3:`` on every
     follower of the PettingZoo env, as the pinned decision does."""
     cluster = "etsc/ClusterContainment-v0"

@@ -11,8 +11,8 @@ from sb3_contrib import MaskablePPO
 from stable_baselines3.common.buffers import RolloutBuffer
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.decisions import SelfTriggeredWrapper
-from agents.elapsed_discount import (
+from agents.train.decisions import SelfTriggeredWrapper
+from agents.train.elapsed_discount import (
     ElapsedRolloutBuffer,
     ElapsedStepsCallback,
     MaskableElapsedRolloutBuffer,

@@ -10,7 +10,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import etsc_envs
-from agents.follower_decisions import FollowerDecisionEnv
+from agents.train.follower_decisions import FollowerDecisionEnv
 from baselines.episodes import run_parallel_episode
 from baselines.self_triggered import SelfTriggeredPolicy
 from etsc_envs.triggers import PAPER_TRIGGERS

@@ -1,5 +1,5 @@
 """The front criterion: a learned front on or below the paper and periodic sweeps over the
-paper sweep's range of transmissions (:mod:`agents.front`)."""
+paper sweep's range of transmissions (:mod:`agents.judge.front`)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from agents.front import (
+from agents.judge.front import (
     envelope,
     envelope_cost,
     envelope_transmissions,
@@ -17,11 +17,11 @@ from agents.front import (
     set_axes,
     verdict_line,
 )
-from agents.pareto import front_verdicts
+from agents.judge.pareto import front_verdicts
 
 
 def point(sent: float, cost: float, failures: int = 0, paper: tuple | None = None) -> dict:
-    """A point as :func:`agents.pareto.pareto` writes it (set aggregates, paper episode)."""
+    """A point as :func:`agents.judge.pareto.pareto` writes it (set aggregates, paper episode)."""
     episode = None
     if paper is not None:
         episode = {"transmissions": paper[0], "mean_cost": paper[1], "failure": None}

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from agents.config import config_from_dict
-from agents.decision_selection import stand_alone_spec
+from agents.train.config import config_from_dict
+from agents.train.decision_selection import stand_alone_spec
 from baselines.self_triggered import DecisionSet
 from etsc_envs.triggers import PeriodicPolicy
 from tests.test_decision_selection import BASE_CONFIG

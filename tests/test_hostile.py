@@ -310,7 +310,7 @@ def test_benchmark_refuses_a_json_path_under_a_file(tmp_path: Path, capsys) -> N
 
 
 def test_results_refuses_an_unknown_id(capsys) -> None:
-    from agents.results import main
+    from agents.judge.results import main
 
     with pytest.raises(SystemExit) as exit_info:
         main(["etsc/Nope-v0", "--model", str(MODELS / "AttitudeTracking-v0_ppo.zip")])
@@ -347,8 +347,8 @@ def test_evaluate_refuses_a_damaged_model_with_one_line(tmp_path: Path, capsys, 
 
 @pytest.mark.parametrize("tool", ["results", "pareto"])
 def test_results_and_pareto_refuse_a_damaged_model(tmp_path: Path, capsys, tool) -> None:
-    from agents.pareto import main as pareto_main
-    from agents.results import main as results_main
+    from agents.judge.pareto import main as pareto_main
+    from agents.judge.results import main as results_main
 
     model = _broken_model(tmp_path, "truncated")
     main = results_main if tool == "results" else pareto_main
@@ -394,7 +394,7 @@ def tiny_training_config(out_dir: Path, **changes) -> dict:
 def train_main(tmp_path: Path, config: dict, *extra: str) -> int:
     import yaml
 
-    from agents.train import main
+    from agents.train.training import main
 
     path = tmp_path / "config.yaml"
     path.write_text(yaml.safe_dump(config), encoding="utf-8")
@@ -426,7 +426,7 @@ def test_train_refuses_an_unknown_env_kwarg_and_leaves_no_out_dir(tmp_path: Path
 )
 def test_config_refuses_bad_hyperparameters(tmp_path: Path, change, key) -> None:
     pytest.importorskip("stable_baselines3")
-    from agents.config import config_from_dict
+    from agents.train.config import config_from_dict
 
     with pytest.raises(ValueError) as error:
         config_from_dict(tiny_training_config(tmp_path / "run", **change))
@@ -435,7 +435,7 @@ def test_config_refuses_bad_hyperparameters(tmp_path: Path, change, key) -> None
 
 def test_config_refuses_an_out_dir_under_a_file(tmp_path: Path) -> None:
     pytest.importorskip("stable_baselines3")
-    from agents.config import config_from_dict
+    from agents.train.config import config_from_dict
 
     blocker = tmp_path / "file"
     blocker.write_text("x")
@@ -627,7 +627,7 @@ def test_a_model_interrupted_while_being_written_is_written_whole(
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
-    from agents.model_files import write_model
+    from agents.train.model_files import write_model
     from baselines.policies import normalization_path
 
     env = VecNormalize(DummyVecEnv([lambda: gym.make(GYM_IDS[0], **SHORT[GYM_IDS[0]])]))
@@ -792,7 +792,7 @@ def test_a_pickle_planted_beside_a_model_is_not_run(tmp_path: Path, capsys) -> N
         main(["etsc/AttitudeTracking-v0", "--policy", f"sb3:{model}", "--env-arg=horizon_s=0.05"])
     assert exit_info.value.code == 2
     line = _error_line(capsys)
-    assert "model_vecnormalize.pkl" in line and "agents.convert_statistics" in line, line
+    assert "model_vecnormalize.pkl" in line and "agents.train.convert_statistics" in line, line
     assert not marker.exists()
 
 
@@ -812,7 +812,7 @@ def test_a_pickle_planted_as_npz_statistics_is_not_run(tmp_path: Path, capsys) -
 
 
 def test_the_converter_refuses_a_planted_pickle_without_running_it(tmp_path: Path, capsys):
-    from agents.convert_statistics import main
+    from agents.train.convert_statistics import main
 
     marker = tmp_path / "ran"
     planted = tmp_path / "model_vecnormalize.pkl"
@@ -885,7 +885,7 @@ def test_statistics_of_another_env_beside_a_model_are_named(tmp_path: Path, caps
 def test_the_converter_keeps_the_statistics_exactly(tmp_path: Path) -> None:
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
-    from agents.convert_statistics import convert
+    from agents.train.convert_statistics import convert
     from baselines.policies import ObservationStatistics
 
     env_id = GYM_IDS[0]
@@ -1000,7 +1000,7 @@ def test_an_interrupted_process_sweep_says_how_to_resume(tmp_path: Path) -> None
     code = (
         "import sys\n"
         "sys.modules['ray'] = None\n"
-        "from agents.sweep import main\n"
+        "from agents.sweep.runner import main\n"
         f"raise SystemExit(main(['--config', {str(config)!r}, '--processes', '1']))\n"
     )
     log = tmp_path / "stderr.txt"
@@ -1104,7 +1104,7 @@ def test_pettingzoo_actions_name_what_they_allow() -> None:
 )
 def test_config_refuses_hyperparameters_out_of_range(tmp_path: Path, change, key) -> None:
     pytest.importorskip("stable_baselines3")
-    from agents.config import config_from_dict
+    from agents.train.config import config_from_dict
 
     hyperparameters = {"n_steps": 64, "batch_size": 64, "n_epochs": 1, **change}
     with pytest.raises(ValueError) as error:
@@ -1150,7 +1150,7 @@ def test_policy_specs_name_what_they_take(capsys, policy, argument, expected) ->
 
 
 def test_pareto_refuses_a_reuse_file_that_is_not_json(tmp_path: Path, capsys) -> None:
-    from agents.pareto import main
+    from agents.judge.pareto import main
 
     not_json = tmp_path / "notjson.zip"
     not_json.write_bytes(b"PK\x03\x04")

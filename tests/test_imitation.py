@@ -1,4 +1,4 @@
-"""Cloning the paper's trigger into an SB3 policy before reinforcement (agents.imitation)."""
+"""Cloning the paper's trigger into an SB3 policy before reinforcement (agents.train.imitation)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ pytest.importorskip("stable_baselines3")
 from stable_baselines3 import PPO
 from stable_baselines3.common.vec_env import VecNormalize
 
-from agents.imitation import clone, collect_demonstrations, paper_trigger
-from agents.vector_adapter import make_sb3_vec_env
+from agents.train.imitation import clone, collect_demonstrations, paper_trigger
+from agents.train.vector_adapter import make_sb3_vec_env
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 SHORT = {"randomize": True, "horizon_s": 0.5}

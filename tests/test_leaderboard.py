@@ -10,7 +10,7 @@ import pytest
 
 pytest.importorskip("rliable")
 
-from agents import leaderboard
+from agents.judge import leaderboard
 
 BOARD = next(b for b in leaderboard.BOARDS if b.env_id == "etsc/AttitudeTracking-v0")
 

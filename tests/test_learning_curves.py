@@ -1,4 +1,4 @@
-"""``python -m agents.learning_curves``: when a run first matches the paper trigger."""
+"""``python -m agents.judge.learning_curves``: when a run first matches the paper trigger."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from agents.learning_curves import learning_curves, main, parse_runs
+from agents.judge.learning_curves import learning_curves, main, parse_runs
 
 PAPER = {"mean_cost": 1.0, "transmissions": 100.0, "failures": 0}
 

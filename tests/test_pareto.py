@@ -1,4 +1,4 @@
-"""``python -m agents.pareto``: the three curves, their JSON and their plot."""
+"""``python -m agents.judge.pareto``: the three curves, their JSON and their plot."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.pareto import PAPER_SWEEPS, RULE_SWEEPS, main, non_dominated, periodic_sweep
+from agents.judge.pareto import PAPER_SWEEPS, RULE_SWEEPS, main, non_dominated, periodic_sweep
 from etsc_envs.triggers.attitude_tracking import PAPER_PSI
 
 
@@ -110,7 +110,7 @@ def test_the_pettingzoo_cluster_shares_its_central_forms_baseline_points(tmp_pat
 def test_costs_within_one_decade_still_get_labelled_ticks() -> None:
     import matplotlib.pyplot as plt
 
-    from agents.pareto import _log_axes
+    from agents.judge.pareto import _log_axes
 
     figure, axes = plt.subplots()
     axes.plot([10, 100, 1000], [3.1, 3.4, 4.2])
@@ -124,10 +124,10 @@ def test_costs_within_one_decade_still_get_labelled_ticks() -> None:
 def test_judged_models_are_read_from_their_judgement_as_a_run_gives_them(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A model judged by agents.results gives, through ``--judged``, the point that running
+    """A model judged by agents.judge.results gives, through ``--judged``, the point that running
     it gives (set aggregates and paper-scenario episode), under its folder's method; a
     judgement of another set size is refused naming ``--judged``."""
-    from agents.results import main as judge
+    from agents.judge.results import main as judge
 
     model = str(Path(__file__).resolve().parents[1] / "models" / "AttitudeTracking-v0_ppo.zip")
     argv = ["etsc/AttitudeTracking-v0", "--env-arg", "horizon_s=0.3", "--set-size", "3"]

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from agents.results import verdict
+from agents.judge.results import verdict
 from baselines.statistics import (
     aggregate_records,
     paired_ratio,
@@ -87,7 +87,7 @@ def test_training_accepts_seeds_outside_the_reserved_ranges() -> None:
 
 def test_a_training_config_seeded_inside_the_test_set_is_refused() -> None:
     pytest.importorskip("stable_baselines3")
-    from agents.config import config_from_dict
+    from agents.train.config import config_from_dict
 
     raw = {
         "env_id": "etsc/AttitudeTracking-v0",

@@ -12,8 +12,8 @@ pytest.importorskip("stable_baselines3")
 
 from stable_baselines3 import PPO
 
-from agents.results import clock_verdict, equal_rate_period, main, markdown, verdict_text
-from agents.vector_adapter import make_sb3_vec_env
+from agents.judge.results import clock_verdict, equal_rate_period, main, markdown, verdict_text
+from agents.train.vector_adapter import make_sb3_vec_env
 from baselines.statistics import paired_ratio
 
 ENV_ID = "etsc/AttitudeTracking-v0"
@@ -103,7 +103,7 @@ def test_a_learned_trigger_that_is_the_clock_is_a_tie(periodic_costs, tie, text)
 def test_seeds_at_one_rate_share_one_run_of_the_clock(tmp_path: Path, monkeypatch) -> None:
     """The clock at a period runs once per set (its episodes depend on the period alone): two
     copies of one model, one clock run per set, and each row keeps the clock's records."""
-    import agents.results as results
+    import agents.judge.results as results
 
     calls = []
     evaluate = results.evaluate

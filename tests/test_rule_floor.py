@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.decisions import SelfTriggeredWrapper
+from agents.train.decisions import SelfTriggeredWrapper
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.self_triggered import DecisionSet

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.config import config_from_dict
-from agents.decision_selection import stand_alone_spec
-from agents.decisions import SelfTriggeredWrapper
+from agents.train.config import config_from_dict
+from agents.train.decision_selection import stand_alone_spec
+from agents.train.decisions import SelfTriggeredWrapper
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.self_triggered import DecisionSet

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from agents.search import (
+from agents.search.cma_es import (
     Evaluator,
     SearchSpace,
     config_from_dict,

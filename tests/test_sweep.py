@@ -21,7 +21,7 @@ import yaml
 pytest.importorskip("stable_baselines3")
 pytest.importorskip("ray.tune")
 
-from agents.sweep import main
+from agents.sweep.runner import main
 from tests.sweep_fixtures import tiny_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -210,7 +210,7 @@ def test_a_search_runs_under_asha_and_optuna_to_saved_models(tmp_path: Path) -> 
 def test_the_last_rollout_is_left_to_the_final_report(monkeypatch, tmp_path: Path) -> None:
     """A scheduler stops a trial that reports its full length: that report must come after
     the model is saved, not from the training loop."""
-    import agents.sweep_trial as sweep_trial
+    import agents.sweep.trial as sweep_trial
 
     reports: list[dict[str, Any]] = []
     monkeypatch.setattr(sweep_trial.tune, "report", reports.append)
@@ -236,8 +236,8 @@ def test_the_last_rollout_is_left_to_the_final_report(monkeypatch, tmp_path: Pat
 
 
 def test_a_summary_names_the_grid_points_that_never_started(tmp_path: Path) -> None:
-    from agents.sweep import summarize
-    from agents.sweep_config import load_sweep_config
+    from agents.sweep.config import load_sweep_config
+    from agents.sweep.runner import summarize
 
     config = load_sweep_config(tiny_sweep(tmp_path))
     wrapped = RuntimeError("task failed\nTraceback ...")

@@ -13,7 +13,7 @@ import yaml
 
 pytest.importorskip("stable_baselines3")
 
-from agents.sweep_config import load_sweep_config, sweep_config_from_dict
+from agents.sweep.config import load_sweep_config, sweep_config_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = str(ROOT / "configs" / "train" / "attitude_tracking_ppo.yaml")
@@ -166,7 +166,8 @@ def test_a_shipped_front_crosses_four_penalties_with_three_seeds(path: Path) -> 
 
 def test_the_package_and_the_tools_do_not_import_ray() -> None:
     code = (
-        "import sys, etsc_envs, agents.train, agents.pareto, agents.results, agents.sweep\n"
+        "import sys, etsc_envs, agents.train.training, agents.judge.pareto, agents.judge.results\n"
+        "import agents.sweep.runner, agents.search.cma_es\n"
         "assert 'ray' not in sys.modules, 'ray was imported'\n"
     )
     subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True)
@@ -176,7 +177,7 @@ def test_without_ray_the_sweep_command_says_which_extra_to_install() -> None:
     code = (
         "import sys\n"
         "sys.modules['ray'] = None  # as if Ray were not installed\n"
-        "from agents.sweep import main\n"
+        "from agents.sweep.runner import main\n"
         "main(['--config', 'configs/sweeps/tiny.yaml'])\n"
     )
     run = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)

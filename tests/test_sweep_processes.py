@@ -26,7 +26,7 @@ def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:
     code = (
         "import sys\n"
         "sys.modules['ray'] = None  # as if Ray were not installed\n"
-        "from agents.sweep import main\n"
+        "from agents.sweep.runner import main\n"
         f"raise SystemExit(main({list(arguments)!r}))\n"
     )
     return subprocess.run(
@@ -79,7 +79,7 @@ def test_resuming_trains_only_the_unfinished_trials(process_sweep) -> None:
 
 
 def test_the_results_tools_read_the_process_sweep(process_sweep) -> None:
-    from agents.sweep_results import read_sweep
+    from agents.sweep.results import read_sweep
 
     trials = read_sweep(process_sweep["results_dir"])
     assert sorted(t.name for t in trials if t.status == "finished") == sorted(FINISHING)

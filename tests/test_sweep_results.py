@@ -1,5 +1,6 @@
-"""A sweep's results folder read back: the reported scores, the summary, and ``agents.pareto`` /
-``agents.results`` on a sweep (``--sweep``). No Ray needed: the folder is built here."""
+"""A sweep's results folder read back: the reported scores, the summary, and
+``agents.judge.pareto`` / ``agents.results`` on a sweep (``--sweep``). No Ray needed: the folder
+is built here."""
 
 from __future__ import annotations
 
@@ -12,8 +13,8 @@ pytest.importorskip("stable_baselines3")
 
 from stable_baselines3 import PPO
 
-from agents import pareto, results
-from agents.sweep_results import (
+from agents.judge import pareto, results
+from agents.sweep.results import (
     SweepTrial,
     final_scores,
     finished_trials,
@@ -22,7 +23,7 @@ from agents.sweep_results import (
     trial_status,
     write_summary,
 )
-from agents.vector_adapter import make_sb3_vec_env
+from agents.train.vector_adapter import make_sb3_vec_env
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 

@@ -12,8 +12,8 @@ import yaml
 
 stable_baselines3 = pytest.importorskip("stable_baselines3")
 
-from agents.config import config_from_dict  # noqa: E402
-from agents.train import (  # noqa: E402
+from agents.train.config import config_from_dict  # noqa: E402
+from agents.train.training import (  # noqa: E402
     CONFIG_FILE,
     MODEL_FILE,
     SUMMARY_FILE,

@@ -10,7 +10,7 @@ from stable_baselines3 import PPO
 from stable_baselines3.common.vec_env import VecMonitor
 
 import etsc_envs
-from agents.vector_adapter import (
+from agents.train.vector_adapter import (
     SB3VecEnvAdapter,
     make_sb3_vec_env,
     make_shared_policy_vec_env,

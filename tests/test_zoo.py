@@ -21,7 +21,7 @@ import pytest
 import yaml
 
 import etsc_envs
-from agents.config import load_config
+from agents.train.config import load_config
 
 ROOT = Path(__file__).resolve().parents[1]
 ZOO_FILE = ROOT / "configs" / "zoo" / "ppo.yml"

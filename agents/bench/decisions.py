@@ -1,6 +1,6 @@
-"""Throughput of self-triggered decisions (:class:`agents.decisions.SelfTriggeredWrapper`).
+"""Throughput of self-triggered decisions (:class:`agents.train.decisions.SelfTriggeredWrapper`).
 
-    python -m agents.decisions_benchmark [--env ID ...] [--repeats R] [--per-instant]
+    python -m agents.bench.decisions [--env ID ...] [--repeats R] [--per-instant]
 
 For each id, three policies: a fixed hold of 2^6 instants, always "follow the paper" (the
 paper's rule at its own threshold), and uniformly random decisions (the default decision set:
@@ -23,7 +23,7 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.decisions import SelfTriggeredWrapper
+from agents.train.decisions import SelfTriggeredWrapper
 
 DEFAULT_IDS = ("etsc/AttitudeTracking-v0", "etsc/InnerFormation-v0")
 HOLD_ACTION = 6

@@ -1,7 +1,7 @@
 """Wall time of judging a self-triggered model: decision by decision against instant by
 instant.
 
-    python -m agents.judging_benchmark ENV_ID --model PATH [--set-size K] [--repeats R]
+    python -m agents.bench.judging ENV_ID --model PATH [--set-size K] [--repeats R]
 
 :func:`baselines.batch.run_batch` runs a :class:`~baselines.self_triggered.SelfTriggeredPolicy`
 decision by decision (one model call per decision for the rows still running, each interval in

@@ -4,7 +4,7 @@ The goal's third criterion (``docs/results.md``) compares curves, not points: ov
 sweep's range of transmissions, the learned front must be on or below both the paper
 trigger's threshold sweep and the periodic sweep. Each curve is read as its **envelope**
 ``E(x)``: the least mean cost the curve reaches with at most ``x`` transmissions. Between two
-of its non-dominated points (:func:`agents.pareto.non_dominated`; points with failures are not
+of its non-dominated points (:func:`agents.judge.pareto.non_dominated`; points with failures are not
 points of a curve: a trigger that loses the loop reaches no accuracy) the envelope joins them
 linearly in cost against log(transmissions) (costs may be 0: paper 003's orbit inside its
 shell); beyond its
@@ -118,7 +118,7 @@ def front_verdict(
     axes: Axes = set_axes,
 ) -> dict[str, Any]:
     """The learned points' front against the paper sweep and the periodic sweep (points of
-    :func:`agents.pareto.pareto`'s curves), on the axes ``axes`` reads (:func:`set_axes`, the
+    :func:`agents.judge.pareto.pareto`'s curves), on the axes ``axes`` reads (:func:`set_axes`, the
     scenario set; :func:`paper_scenario_axes`, the paper scenario). Points with failures are
     left out of every curve. Returns the paper sweep's ``range`` of transmissions, the
     learned front's (``None`` if every learned point failed: the criterion is then not met), a

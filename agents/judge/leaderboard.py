@@ -2,8 +2,8 @@
 
     python -m agents.leaderboard [--records DIR] [--out PATH]
 
-Reads the judged records under ``docs/results/`` — ``results.json`` of ``agents.results``,
-``pareto.json`` of ``agents.pareto`` and the JSON of ``baselines.evaluate --json`` — and runs
+Reads the judged records under ``docs/results/`` — ``results.json`` of ``agents.judge.results``,
+``pareto.json`` of ``agents.judge.pareto`` and the JSON of ``baselines.evaluate --json`` — and runs
 nothing. Writes ``docs/leaderboard.md`` and one figure per id beside it
 (``docs/leaderboard/<EnvName>.png``).
 

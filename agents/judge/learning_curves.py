@@ -1,7 +1,7 @@
 """How fast each decision structure learns: validation curves of training runs against
 simulated instants and wall-clock time.
 
-    python -m agents.learning_curves --run LABEL=RUN_DIR [--run LABEL=RUN_DIR ...]
+    python -m agents.judge.learning_curves --run LABEL=RUN_DIR [--run LABEL=RUN_DIR ...]
                                      [--include LEARNING_CURVES_JSON ...]
                                      [--cost-tolerance 1.05] [--out DIR]
 
@@ -69,7 +69,7 @@ def search_evaluations(folder: Path) -> list[dict[str, Any]]:
     validating generation in ``generations.jsonl``) in the form of a training run's
     ``evaluations.json``, the paper trigger evaluated once on the same validation scenarios
     (those of the search's ``config.yaml``) as the reference."""
-    from agents.search import load_config
+    from agents.search.cma_es import load_config
     from baselines.evaluate import evaluate
 
     config = load_config(folder / "config.yaml")
@@ -213,7 +213,7 @@ def plot(result: dict[str, Any], path: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m agents.learning_curves",
+        prog="python -m agents.judge.learning_curves",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -1,7 +1,7 @@
 """Accuracy against transmissions: the paper's trigger, periodic sampling and learned triggers,
 under the test protocol.
 
-    python -m agents.pareto ENV_ID [--model PATH ...] [--sweep RESULTS_DIR ...]
+    python -m agents.judge.pareto ENV_ID [--model PATH ...] [--sweep RESULTS_DIR ...]
                                    [--judged RESULTS_DIR ...]
                                    [--scenarios test|validation] [--set-size K]
                                    [--env-arg k=v ...] [--out DIR]
@@ -35,7 +35,7 @@ with failures crossed, and the paper scenario in a second panel.
 A method of ``learned:`` triggers (a search's) is also judged against the **hand-menu front**,
 the envelope of every point that no search found: the sweeps, every other model, and every
 point of each ``--menu`` result (earlier fronts: the pinned rule variants of the decision sets,
-the headlines among them), drawn as a curve of its own (:func:`agents.front.menu_verdict`).
+the headlines among them), drawn as a curve of its own (:func:`agents.judge.front.menu_verdict`).
 
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
 ``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper, periodic (and other
@@ -56,8 +56,7 @@ import matplotlib.pyplot as plt
 from matplotlib import ticker
 
 import etsc_envs
-from agents.evaluation import episode_summary
-from agents.front import (
+from agents.judge.front import (
     front_verdict,
     menu_line,
     menu_verdict,
@@ -65,7 +64,8 @@ from agents.front import (
     set_axes,
     verdict_line,
 )
-from agents.sweep_results import sweep_models
+from agents.sweep.results import sweep_models
+from agents.train.validation_callback import episode_summary
 from baselines.cli import (
     limit_torch_threads,
     model_spec,
@@ -187,14 +187,14 @@ def point_of(
 def judged_points(
     folder: Path, env_id: str, env_kwargs: dict[str, Any], scenarios: str, set_size: int
 ) -> list[dict[str, Any]]:
-    """The learned points of every model judged by :mod:`agents.results` under ``folder``
+    """The learned points of every model judged by :mod:`agents.judge.results` under ``folder``
     (each ``results.json``, in path order), read from its records on ``scenarios`` (and on
     the paper scenario where it was judged there), with ``folder``'s name as their method.
     ``ValueError`` naming ``--judged`` if a judgement is of another id, env kwargs or scenario
     set, or if the folder holds none."""
     files = sorted(Path(folder).rglob("results.json"))
     if not files:
-        raise ValueError(f"--judged: no results.json of agents.results under {str(folder)!r}")
+        raise ValueError(f"--judged: no results.json of agents.judge.results under {str(folder)!r}")
     points = []
     for path in files:
         judged = json.loads(path.read_text(encoding="utf-8"))
@@ -304,7 +304,7 @@ def pareto(
 
 def front_verdicts(result: dict[str, Any]) -> dict[str, dict[str, Any]]:
     """Each learned method's front against the paper and periodic sweeps
-    (:func:`agents.front.front_verdict`), on the scenario set (``set``) and on the paper
+    (:func:`agents.judge.front.front_verdict`), on the scenario set (``set``) and on the paper
     scenario (``paper``, where its points ran there)."""
     curves = result["curves"]
     verdicts: dict[str, dict[str, Any]] = {}
@@ -523,7 +523,7 @@ def _earlier_result(text: str) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m agents.pareto",
+        prog="python -m agents.judge.pareto",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -549,7 +549,7 @@ def main(argv: list[str] | None = None) -> int:
         default=[],
         type=Path,
         metavar="RESULTS_DIR",
-        help="add the models judged by agents.results under a folder, read from their "
+        help="add the models judged by agents.judge.results under a folder, read from their "
         "records without running them again (repeatable)",
     )
     parser.add_argument(

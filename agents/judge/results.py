@@ -45,7 +45,7 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs
-from agents.sweep_results import finished_trials
+from agents.sweep.results import finished_trials
 from baselines.cli import (
     episode_setup,
     limit_torch_threads,

@@ -576,7 +576,3 @@ def main(argv: list[str] | None = None) -> int:
     chosen = learned.search["chosen_generation"]
     print(f"learned trigger: {out / 'learned.json'} (the mean of generation {chosen})")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -3,7 +3,7 @@ trial's values become one training config. No Ray here: this module only reads a
 
 A sweep config is a YAML mapping with these keys (the optional ones show their default):
 
-* ``base`` — the training config (``configs/train/*.yaml``, keys in :mod:`agents.config`)
+* ``base`` — the training config (``configs/train/*.yaml``, keys in :mod:`agents.train.config`)
   that every trial starts from;
 * ``results_dir`` — the sweep's results folder: one subfolder per trial under ``trials/``
   (model, normalisation statistics, resolved config, evaluations), the sweep summary and
@@ -23,7 +23,7 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
   tenth of ``total_timesteps``);
 * ``search_algorithm: null`` — ``optuna`` draws the ``search`` values with Tune's
   ``OptunaSearch`` (then ``grid`` must be empty); search only;
-* ``metric: null``, ``mode: null`` — the reported metric (:data:`agents.sweep_results.METRICS`)
+* ``metric: null``, ``mode: null`` — the reported metric (:data:`agents.sweep.results.METRICS`)
   that the scheduler or search algorithm optimises, and ``min`` or ``max``; required with
   either of them. A trial reports to Tune only once it has that metric (the evaluation
   metrics need ``evaluation_every``);
@@ -54,14 +54,14 @@ from typing import Any
 
 import yaml
 
-from agents.config import (
+from agents.sweep.results import EVALUATION_METRICS, METRICS, TRIALS_DIR
+from agents.train.config import (
     OPTIONAL_DEFAULTS,
     REQUIRED_KEYS,
     TrainConfig,
     config_from_dict,
     require_key_set,
 )
-from agents.sweep_results import EVALUATION_METRICS, METRICS, TRIALS_DIR
 
 KINDS = ("front", "search")
 SCHEDULERS = ("asha",)

@@ -2,11 +2,11 @@
 worker process of a process pool.
 
 ``python -m agents.sweep --config configs/sweeps/NAME.yaml --processes N`` takes this path.
-It writes the same results folder as the Ray path (:mod:`agents.sweep_results`: the trials'
+It writes the same results folder as the Ray path (:mod:`agents.sweep.results`: the trials'
 folders, ``sweep_settings.json`` and ``sweep_summary.json``, no ``tune/``), so that
-``agents.results --sweep`` and ``agents.pareto --sweep`` read either. It runs grids only (kinds
-``front`` and ``grid`` without a scheduler or a search, which need Tune). A trial whose training
-had finished is not run again, so the same command continues an interrupted sweep; an
+``agents.results --sweep`` and ``agents.judge.pareto --sweep`` read either. It runs grids
+only (kinds ``front`` and ``grid`` without a scheduler or a search, which need Tune). A trial
+whose training had finished is not run again, so the same command continues an interrupted sweep; an
 unfinished trial starts again from its newest checkpoint where its config saves them.
 
 Workers are spawned, not forked: a forked child of a process that has run torch can deadlock
@@ -22,8 +22,8 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
-from agents.sweep_config import SweepConfig
-from agents.sweep_results import (
+from agents.sweep.config import SweepConfig
+from agents.sweep.results import (
     EVALUATIONS_FILE,
     SweepTrial,
     final_scores,
@@ -33,7 +33,7 @@ from agents.sweep_results import (
     trial_status,
     write_summary,
 )
-from agents.train import CHECKPOINT_DIR, latest_checkpoint, train
+from agents.train.training import CHECKPOINT_DIR, latest_checkpoint, train
 
 
 def check_process_sweep(sweep: SweepConfig, processes: int) -> None:

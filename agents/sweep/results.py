@@ -1,7 +1,7 @@
 """A sweep's results folder: the scores a trial reports, the sweep summary, and reading the
-finished trials back (for ``agents.pareto`` and ``agents.results``). No Ray here.
+finished trials back (for ``agents.judge.pareto`` and ``agents.judge.results``). No Ray here.
 
-Layout of a sweep's ``results_dir`` (see :mod:`agents.sweep_config`)::
+Layout of a sweep's ``results_dir`` (see :mod:`agents.sweep.config`)::
 
     sweep_summary.json          every trial: name, swept values, status, error, final scores
     sweep_settings.json         the validated sweep config it started with (``--resume``
@@ -25,8 +25,8 @@ import numpy as np
 
 from etsc_envs.core.files import atomic_write_text
 
-if TYPE_CHECKING:  # agents.sweep_config imports this module
-    from agents.sweep_config import SweepConfig
+if TYPE_CHECKING:  # agents.sweep.config imports this module
+    from agents.sweep.config import SweepConfig
 
 SUMMARY_FILE = "sweep_summary.json"
 SETTINGS_FILE = "sweep_settings.json"

@@ -7,8 +7,8 @@ Without ``--address`` (and without ``RAY_ADDRESS``) the command starts a Ray ins
 machine and stops it at the end; with one it joins that cluster (``ray start --head`` on one
 machine, ``ray start --address HEAD:6379`` on the others, or ``ray up``). Each trial reserves
 ``cpus_per_trial`` cores, so Ray runs as many trials at once as the cores allow. The config's
-keys are in :mod:`agents.sweep_config`; the results folder's layout in
-:mod:`agents.sweep_results`.
+keys are in :mod:`agents.sweep.config`; the results folder's layout in
+:mod:`agents.sweep.results`.
 
 ``--resume`` continues an interrupted sweep from Tune's saved state (``Tuner.restore``):
 finished and failed trials are not run again; interrupted ones start again (from their newest
@@ -20,7 +20,7 @@ trial failed, or when a front is incomplete, else 0.
 
 ``--processes N`` runs a grid sweep (kinds ``front`` and ``grid``, no scheduler or search)
 without Ray, N trials at a time in worker processes on this machine
-(:mod:`agents.sweep_processes`); it writes the same results folder, and ``--resume`` continues
+(:mod:`agents.sweep.processes`); it writes the same results folder, and ``--resume`` continues
 it by running the trials that had not finished.
 
 Needs the ``sweep`` extra (``pip install -e ".[train,sweep]"``), except with ``--processes``.
@@ -40,9 +40,9 @@ from urllib.parse import urlsplit
 
 import yaml
 
-from agents.sweep_config import SweepConfig, load_sweep_config
-from agents.sweep_processes import run_sweep_in_processes
-from agents.sweep_results import (
+from agents.sweep.config import SweepConfig, load_sweep_config
+from agents.sweep.processes import run_sweep_in_processes
+from agents.sweep.results import (
     SweepTrial,
     final_scores,
     one_line_error,
@@ -99,7 +99,7 @@ def build_tuner(sweep: SweepConfig, resume: bool) -> Any:
     """A ``Tuner`` for the sweep: new, or restored from its saved state when ``resume``."""
     from ray import tune
 
-    from agents.sweep_trial import run_trial, trial_dirname
+    from agents.sweep.trial import run_trial, trial_dirname
 
     trainable = tune.with_resources(
         tune.with_parameters(run_trial, sweep=sweep), {"cpu": sweep.cpus_per_trial}
@@ -298,7 +298,3 @@ def main(argv: list[str] | None = None) -> int:
         )
         return 130
     return _report(sweep, trials)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

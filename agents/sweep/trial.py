@@ -17,21 +17,21 @@ import numpy as np
 from ray import tune
 from stable_baselines3.common.callbacks import BaseCallback
 
-from agents.sweep_config import SweepConfig
-from agents.sweep_results import (
+from agents.sweep.config import SweepConfig
+from agents.sweep.results import (
     EVALUATIONS_FILE,
     final_scores,
     last_evaluation,
     scores,
     training_finished,
 )
-from agents.train import CHECKPOINT_DIR, latest_checkpoint, train
+from agents.train.training import CHECKPOINT_DIR, latest_checkpoint, train
 
 
 class TuneReportCallback(BaseCallback):
     """After every rollout but the last, report to Tune the training steps, the mean return of
     the recent training episodes and the training run's last evaluation against the paper
-    trigger (read from its ``evaluations.json``; see :func:`agents.sweep_results.scores`).
+    trigger (read from its ``evaluations.json``; see :func:`agents.sweep.results.scores`).
 
     The last rollout (``total_timesteps`` reached) reports nothing: a scheduler stops a trial
     that reports its full length, which would end it before its model is saved; the trial

@@ -44,36 +44,36 @@ A config is a YAML mapping with these keys (the optional ones show their default
   have been trained for the observation and action spaces of ``env_id``;
 * ``imitation_steps: 0`` — before reinforcement, run the paper's trigger for that many steps
   on the training envs and clone it into the policy (and its returns into the value
-  function; :mod:`agents.imitation`); 0 starts from a random policy;
+  function; :mod:`agents.train.imitation`); 0 starts from a random policy;
 * ``imitation_epochs: 10`` — passes over those steps when cloning;
 * ``imitation_decision: null`` — with ``decisions``, the decision to clone for
   ``imitation_steps`` decisions instead of the per-instant paper trigger, by its label
   (``"paper x0.25"``, ``"hold 64"``: :meth:`baselines.self_triggered.DecisionSet.label`;
-  :func:`agents.imitation.imitate_decision`); needed with ``decisions`` and
+  :func:`agents.train.imitation.imitate_decision`); needed with ``decisions`` and
   ``imitation_steps``, refused without ``decisions``;
   ``imitation_decision: best`` chooses it per run instead: the decision with the highest mean
   return on the first ``evaluation_scenarios`` validation scenarios at the run's env kwargs,
-  its transmission penalty among them (:mod:`agents.decision_selection`; recorded in
+  its transmission penalty among them (:mod:`agents.train.decision_selection`; recorded in
   ``out_dir/decision_selection.json``), so that each λ of a front starts from its own
   baseline;
 * ``imitation_candidates: null`` — with ``imitation_decision: best``, the labels it chooses
   among (``null``: every decision of the set);
 * ``imitation_selection_cache: null`` — with ``imitation_decision: best``, a folder in which
   runs that differ in their transmission penalty alone (a front's trials) share the
-  candidates' validation runs (:func:`agents.decision_selection.select_decision`);
+  candidates' validation runs (:func:`agents.train.decision_selection.select_decision`);
 * ``imitation_pinned_probability: null`` — with ``imitation_decision``, a probability p in
   (0, 1): after cloning, the policy's action head is set to take the cloned decision with
-  probability p at every observation (:func:`agents.imitation.pin_decision`), so that
+  probability p at every observation (:func:`agents.train.imitation.pin_decision`), so that
   training starts from the fixed decision exactly rather than from a fit of it;
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
-  keywords of :class:`agents.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
+  keywords of :class:`agents.train.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
   ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``, ``rule_floor``,
   ``rule_channel_heartbeat``, ``rule_keywords``, ``holds``; its ``gamma`` is
   ``hyperparameters.gamma``), on a
   ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
-  :class:`agents.follower_decisions.FollowerDecisionEnv`; cloning with
+  :class:`agents.train.follower_decisions.FollowerDecisionEnv`; cloning with
   ``imitation_decision``). PPO, A2C and MaskablePPO then discount by elapsed instants
-  (:mod:`agents.elapsed_discount`); the models are saved with their decision set beside
+  (:mod:`agents.train.elapsed_discount`); the models are saved with their decision set beside
   them, so that ``sb3:`` deploys them as transmit/hold policies;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
   batches of a few dozen rows run fastest on one thread; more threads contend with the
@@ -101,8 +101,8 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
-from agents.decision_selection import BEST_DECISION
-from agents.decisions import make_decision_env
+from agents.train.decision_selection import BEST_DECISION
+from agents.train.decisions import make_decision_env
 from baselines.cli import require_env_id
 from baselines.policies import require_model_fits
 from baselines.self_triggered import DecisionSet
@@ -315,7 +315,7 @@ def _check_decisions(
     values: Mapping[str, Any], algorithm: str, env_id: str, env_kwargs: dict[str, Any]
 ) -> dict[str, Any] | None:
     """``values["decisions"]`` if it is null or keywords that build a
-    :class:`~agents.decisions.SelfTriggeredWrapper` for ``env_id``."""
+    :class:`~agents.train.decisions.SelfTriggeredWrapper` for ``env_id``."""
     label = values["imitation_decision"]
     if values["decisions"] is None:
         if algorithm == "MaskablePPO":

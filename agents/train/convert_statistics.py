@@ -1,6 +1,6 @@
 """Convert observation statistics pickled by earlier versions into data.
 
-    python -m agents.convert_statistics NAME_vecnormalize.pkl [...]
+    python -m agents.train.convert_statistics NAME_vecnormalize.pkl [...]
 
 Earlier versions saved a model's ``VecNormalize`` beside it with :mod:`pickle`, and reading a
 pickle runs whatever code it names. This converter reads such a file without running any: its
@@ -127,7 +127,7 @@ def convert(path: str | Path) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m agents.convert_statistics",
+        prog="python -m agents.train.convert_statistics",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

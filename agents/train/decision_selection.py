@@ -9,7 +9,7 @@ baseline. :func:`select_decision` runs each candidate decision, always taken, on
 protocol's **validation** scenarios (never the test set) with the training env's keywords,
 λ among them, and picks the one whose mean return is highest: the best member of the policy
 class's fixed decisions at that λ. A front trained from a sweep of λ (``imitation_decision:
-best``, :mod:`agents.config`) then starts each λ from its own baseline instead of one label
+best``, :mod:`agents.train.config`) then starts each λ from its own baseline instead of one label
 shared by every λ, so its points move along the transmission axis with λ.
 
 A decision that equals a stand-alone trigger when always taken (:func:`stand_alone_spec`:
@@ -31,8 +31,8 @@ from typing import Any
 
 import gymnasium as gym
 
-from agents.evaluation import deployment, set_summary
-from agents.imitation import FixedDecision
+from agents.train.imitation import FixedDecision
+from agents.train.validation_callback import deployment, set_summary
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
@@ -84,7 +84,7 @@ def constant_decision_policy(
 ) -> Any:
     """A transmit/hold policy that always takes ``action`` of ``decisions``: its stand-alone
     trigger where :func:`stand_alone_spec` names one, else the deployed decision policy
-    (``deployed``: :func:`agents.evaluation.deployment`'s schedule and spaces)."""
+    (``deployed``: :func:`agents.train.validation_callback.deployment`'s schedule and spaces)."""
     spec = stand_alone_spec(decisions, action)
     if spec is None:
         return SelfTriggeredPolicy(FixedDecision(action), *deployed)
@@ -112,8 +112,8 @@ def select_decision(
     λ), decision set, scenario set and candidate list, written by the first run that needs it.
     Ties go to the earlier candidate. Returns ``{"chosen": label, "transmission_penalty": λ,
     "scenarios": the set described, "candidates": {label: set summary at λ}}`` (each summary
-    :func:`agents.evaluation.set_summary`'s); ``ValueError`` naming ``imitation_candidates``
-    for a label the set lacks.
+    :func:`agents.train.validation_callback.set_summary`'s); ``ValueError`` naming
+    ``imitation_candidates`` for a label the set lacks.
     """
     labels = (
         [decisions.label(action) for action in range(decisions.action_space.n)]

@@ -13,13 +13,13 @@ in Python. Its reward is the interval's rewards discounted within it, ``sum_i ga
 r_i`` over the ``n`` instants it ran, and ``info["elapsed_steps"] = n``, so that an algorithm
 discounting the next decision by ``gamma**n`` keeps the meaning of
 the per-instant return: Stable-Baselines3 discounts every decision by one constant ``gamma``
-unless it trains with the buffers and callback of :mod:`agents.elapsed_discount` and the same
+unless it trains with the buffers and callback of :mod:`agents.train.elapsed_discount` and the same
 ``gamma`` as the wrapper's. ``action_masks()`` gives the
 shield's mask for sb3-contrib's ``MaskablePPO``; an unsafe action given anyway is replaced as
 :meth:`~baselines.self_triggered.IntervalSchedule.shielded` says (``info["action"]`` is the one
 run). A model trained here deploys as a transmit/hold policy once its decision set is saved
 beside it (``wrapper.decisions.save(model_path)``). A PettingZoo id's agents take their
-decisions apart, in :class:`agents.follower_decisions.FollowerDecisionEnv`;
+decisions apart, in :class:`agents.train.follower_decisions.FollowerDecisionEnv`;
 :func:`make_decision_env` builds whichever of the two an id takes.
 """
 
@@ -32,7 +32,7 @@ import numpy as np
 from gymnasium.wrappers import OrderEnforcing, PassiveEnvChecker
 
 import etsc_envs
-from agents.follower_decisions import FollowerDecisionEnv
+from agents.train.follower_decisions import FollowerDecisionEnv
 from baselines.self_triggered import (
     DEFAULT_MAX_EXPONENT,
     DecisionSet,
@@ -60,7 +60,7 @@ def interval_env(env: gym.Env) -> EventTriggeredEnv | None:
 class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     """Decisions over intervals of a transmit/hold env built by ``gym.make`` (its id names the
     paper trigger; Gymnasium ids only: a PettingZoo id's agents decide in
-    :class:`~agents.follower_decisions.FollowerDecisionEnv`).
+    :class:`~agents.train.follower_decisions.FollowerDecisionEnv`).
 
     Args:
         env: the transmit/hold env.
@@ -228,7 +228,7 @@ def make_decision_env(
 ) -> SelfTriggeredWrapper | FollowerDecisionEnv:
     """Self-triggered decisions in ``env_id`` built with ``env_kwargs``: a
     :class:`SelfTriggeredWrapper` over ``gym.make`` for a Gymnasium id, one agent's
-    :class:`~agents.follower_decisions.FollowerDecisionEnv` for a PettingZoo id (its teammates
+    :class:`~agents.train.follower_decisions.FollowerDecisionEnv` for a PettingZoo id (its teammates
     taking ``teammate_decision`` until they follow a model; ``None``: the paper's rule).
     ``decisions`` holds the decision set's keywords."""
     if env_id in etsc_envs.PETTINGZOO_ENV_IDS:

@@ -11,7 +11,7 @@ other followers take their decisions from the shared policy at their own decisio
 current observation statistics; before that, one fixed decision). The step runs the shared loop
 instant by instant until the learner's interval ends, and pays the learner its own channel's
 rewards discounted within the interval (``sum_i gamma**i * r_i``, ``info["elapsed_steps"] =
-n``: the convention of :class:`agents.decisions.SelfTriggeredWrapper`).
+n``: the convention of :class:`agents.train.decisions.SelfTriggeredWrapper`).
 
 Deployed, the model is a :class:`~baselines.self_triggered.SelfTriggeredPolicy` serving every
 agent of the PettingZoo env (one row of interval state per agent), as ``baselines.evaluate
@@ -27,7 +27,7 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs
-from agents.imitation import FixedDecision
+from agents.train.imitation import FixedDecision
 from baselines.policies import NormalizedModel
 from baselines.self_triggered import (
     DEFAULT_MAX_EXPONENT,

@@ -14,7 +14,7 @@ then trains the policy's action head to reproduce its decisions (cross-entropy) 
 head to predict the discounted returns of the collected episodes.
 
 :func:`imitate_decision` does the same for self-triggered decisions
-(:class:`agents.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
+(:class:`agents.train.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
 the set (the better of the paper's rule at some threshold and the best clock, chosen on the
 validation set), and returns are discounted by the instants each decision lasted. A fitted
 clone of one fixed decision agrees with it on the states the demonstrations visited only:

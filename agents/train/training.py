@@ -13,7 +13,7 @@ timesteps, steps per second and the last episodes' returns and metrics), and as 
 ``checkpoints/``, ``tensorboard/`` and ``evaluations.json`` (the policy against the paper's
 trigger during training), and with ``imitation_decision: best`` ``decision_selection.json``
 (every candidate decision's validation summary and the one chosen,
-:mod:`agents.decision_selection`). ``--resume`` continues from the newest intact checkpoint in
+:mod:`agents.train.decision_selection`). ``--resume`` continues from the newest intact checkpoint in
 ``checkpoints/`` up to ``total_timesteps``, keeping the evaluation history up to that
 checkpoint; it refuses checkpoints written under another config (``checkpoints/run.yaml``
 records the config that wrote them; only :data:`RESUMABLE_CHANGES` may differ).
@@ -59,18 +59,18 @@ from stable_baselines3.common.on_policy_algorithm import OnPolicyAlgorithm
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 
 import etsc_envs
-from agents.config import TrainConfig, load_config
-from agents.decision_selection import BEST_DECISION, select_decision
-from agents.decisions import make_decision_env
-from agents.elapsed_discount import (
+from agents.train.config import TrainConfig, load_config
+from agents.train.decision_selection import BEST_DECISION, select_decision
+from agents.train.decisions import make_decision_env
+from agents.train.elapsed_discount import (
     ElapsedRolloutBuffer,
     ElapsedStepsCallback,
     MaskableElapsedRolloutBuffer,
 )
-from agents.evaluation import PaperComparisonCallback
-from agents.imitation import imitate_decision, imitate_paper_trigger
-from agents.model_files import write_model
-from agents.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
+from agents.train.imitation import imitate_decision, imitate_paper_trigger
+from agents.train.model_files import write_model
+from agents.train.validation_callback import PaperComparisonCallback
+from agents.train.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
 from baselines.policies import (
     ENV_ID_ATTRIBUTE,
     ObservationStatistics,
@@ -317,7 +317,7 @@ def _train(
 
 def _selected_decision(config: TrainConfig, out_dir: Path, fresh: bool) -> str:
     """The decision an ``imitation_decision: best`` run starts from: chosen on the validation
-    scenarios at the run's env kwargs (:func:`~agents.decision_selection.select_decision`) and
+    scenarios at the run's env kwargs (:func:`~agents.train.decision_selection.select_decision`) and
     recorded in ``out_dir/decision_selection.json`` on a fresh run, read back from there on a
     resume."""
     path = out_dir / SELECTION_FILE
@@ -418,7 +418,7 @@ def decision_set(config: TrainConfig, env: VecEnv) -> DecisionSet | None:
 class AtomicCheckpointCallback(CheckpointCallback):
     """SB3's checkpoints (``model_<N>_steps.zip`` with ``model_vecnormalize_<N>_steps.npz``
     and, for self-triggered decisions, ``model_<N>_steps_decisions.json``), written through
-    temporary files, the model last (:func:`~agents.model_files.write_model`)."""
+    temporary files, the model last (:func:`~agents.train.model_files.write_model`)."""
 
     def __init__(self, *args: Any, decisions: DecisionSet | None = None, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -626,7 +626,7 @@ def make_training_env(config: TrainConfig, checkpoint: Path | None = None) -> Ve
     the id's native vector env through :class:`SB3VecEnvAdapter` when it has
     one (all etsc-envs ids do), else a ``DummyVecEnv`` of single envs; for a PettingZoo id,
     every agent of the shared loops' vector env
-    (:class:`~agents.vector_adapter.SharedPolicyVecEnv`)."""
+    (:class:`~agents.train.vector_adapter.SharedPolicyVecEnv`)."""
     if config.decisions is not None:
         env: VecEnv = make_vec_env(
             functools.partial(training_decision_env, config),
@@ -775,7 +775,3 @@ def main(argv: list[str] | None = None) -> int:
         if path.name != LOCK_FILE:
             print(f"wrote {path}")
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -16,7 +16,7 @@ import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
-from agents.model_files import write_model
+from agents.train.model_files import write_model
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
