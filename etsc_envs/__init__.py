@@ -13,7 +13,7 @@ as ``"parallel"`` and ``"aec"`` envs::
     aec = pettingzoo.make("aec", "etsc/ClusterContainment-v0", max_cycles=1000)
 """
 
-from typing import Any
+from typing import Any, Literal
 
 import pettingzoo
 from gymnasium.envs.registration import register, registry
@@ -56,8 +56,12 @@ PETTINGZOO_ENV_IDS = {
 convention); the id is registered with ``pettingzoo.register`` for both env types."""
 
 _PETTINGZOO_REGISTRIES = {"parallel": pettingzoo.parallel_registry, "aec": pettingzoo.aec_registry}
+_PETTINGZOO_FUNCTIONS: tuple[tuple[Literal["parallel", "aec"], str], ...] = (
+    ("parallel", "parallel_env"),
+    ("aec", "env"),
+)
 for _env_id, _module in PETTINGZOO_ENV_IDS.items():
-    for _env_type, _function in (("parallel", "parallel_env"), ("aec", "env")):
+    for _env_type, _function in _PETTINGZOO_FUNCTIONS:
         if _env_id not in _PETTINGZOO_REGISTRIES[_env_type]:
             pettingzoo.register(_env_type, _env_id, f"{_module}:{_function}")
 

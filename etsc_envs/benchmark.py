@@ -76,7 +76,7 @@ def repeat_rate(run: Callable[[int], float], work: int, repeats: int) -> dict[st
 def random_bits(space: gym.Space, count: int, seed: int) -> np.ndarray:
     """``count`` seeded samples of a ``Discrete(2)`` or ``MultiBinary`` (batch) space."""
     rng = np.random.default_rng(seed + 1)
-    shape = () if isinstance(space, gym.spaces.Discrete) else space.shape
+    shape = () if isinstance(space, gym.spaces.Discrete) else space.shape or ()
     return rng.integers(0, 2, size=(count, *shape))
 
 
@@ -341,7 +341,7 @@ def main(argv: list[str] | None = None) -> int:
         "envs": envs,
     }
     if args.reproductions is not None:
-        papers = args.reproductions or list(PAPERS)
+        papers: list[str] = args.reproductions or list(PAPERS)
         payload["reproductions"] = benchmark_reproductions(papers, args.repeats)
     if args.protocol is not None:
         ids = args.env or [*ENV_IDS, *PETTINGZOO_ENV_IDS]

@@ -77,7 +77,8 @@ def grid_layout(outer_radius_m: float, spacing_m: float) -> tuple[np.ndarray, tu
     (plus the margin) with two spare nodes on each side (for the central differences)."""
     half = int(np.ceil((outer_radius_m + GRID_MARGIN_M) / spacing_m)) + 2
     origin = np.full(3, -half * spacing_m)
-    return origin, (2 * half + 1,) * 3
+    nodes = 2 * half + 1
+    return origin, (nodes, nodes, nodes)
 
 
 def needed_cells(
@@ -190,7 +191,8 @@ def save(arrays: dict[str, np.ndarray], path: str | Path) -> Path:
     """Write a grid (as returned by :func:`build`) to a compressed ``.npz`` file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, **arrays)
+    # NumPy's stub types **arrays as if one could be its allow_pickle keyword.
+    np.savez_compressed(path, **arrays)  # pyright: ignore[reportArgumentType]
     return path
 
 

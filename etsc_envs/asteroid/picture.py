@@ -100,7 +100,7 @@ def _draw_body(axes: Any, facets: np.ndarray, view: np.ndarray, sun: np.ndarray)
     shade = (0.3 + 0.55 * light)[:, None] * np.ones(3)
     polygons = facets[order] @ view[:2].T
     axes.add_collection(
-        PolyCollection(polygons, facecolors=shade, edgecolors=shade, linewidths=0.3)
+        PolyCollection(list(polygons), facecolors=shade, edgecolors=shade, linewidths=0.3)
     )
 
 

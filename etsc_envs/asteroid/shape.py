@@ -274,7 +274,8 @@ def itokawa_shape(n_vertices: int = PAPER_VERTEX_COUNT) -> ShapeModel:
         return _two_lobe_shape(exponent, n_vertices).volume_m3 / ITOKAWA_VOLUME_M3 - 1.0
 
     exponent = brentq(volume_gap, 2.0, 4.0, xtol=1e-12)
-    shape = _two_lobe_shape(exponent, n_vertices)
+    # SciPy types brentq's root as a union with its full_output=True result.
+    shape = _two_lobe_shape(exponent, n_vertices)  # pyright: ignore[reportArgumentType]
     return ShapeModel(shape.vertices, shape.faces, f"itokawa-like ({len(shape.faces)} facets)")
 
 
@@ -410,7 +411,10 @@ def _parse_ply(raw: bytes, name: str) -> tuple[list, list]:
             if element == "vertex":
                 vertices.append([record["x"], record["y"], record["z"]])
             elif element == "face":
-                polygon = [int(i) for i in record[face_list]]
+                indices = record[face_list]
+                if not isinstance(indices, list):
+                    raise ShapeFileError(f"{name}: PLY face property {face_list!r} is not a list")
+                polygon = [int(i) for i in indices]
                 if len(polygon) < 3:
                     raise ShapeFileError(f"{name}: PLY face with {len(polygon)} vertices")
                 faces.extend(_fan(polygon))

@@ -38,6 +38,7 @@ class ClusterContainmentEnv(EventTriggeredParallelEnv):
         "render_fps": 10,
         "is_parallelizable": True,
     }
+    loop: ClusterContainmentCentralEnv
 
     def __init__(
         self,

@@ -15,6 +15,7 @@ text's statements about them hold (docs/fidelity.md, paper 001, readings 1-3).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -153,19 +154,19 @@ class ClusterContainmentParams:
 
     scenario: str = "paper"
     """'paper' (section 5.1, Figure 2, Table 1) or 'pi1' (section 5.2, Figure 5, Table 2)."""
-    adjacency: object = None
+    adjacency: Any = None
     """(N+M)×(N+M) adjacency, a_ij > 0 when i receives from j (section 2.3); followers first."""
-    leader_attitudes: object = None
+    leader_attitudes: Any = None
     """M×3 stationary leader MRPs, eq. (63) / eq. (70), rad."""
-    nominal_inertias: object = None
+    nominal_inertias: Any = None
     """N×3×3 nominal inertias J_0i, eq. (64), kg·m² (the plant's J_i = J_0i + ΔJ_i)."""
-    inertia_uncertainty: object = None
+    inertia_uncertainty: Any = None
     """N×3×3 ΔJ_i of eq. (5); not given by the paper, None means zero (docs/fidelity.md)."""
-    initial_attitudes: object = None
+    initial_attitudes: Any = None
     """N×3 σ_i(0), Table 1 / Table 2, rad."""
-    initial_rates: object = None
+    initial_rates: Any = None
     """N×3 ω_i(0), Table 1 / Table 2, rad/s."""
-    constant_disturbances: object = None
+    constant_disturbances: Any = None
     """N×3 constant torques d_li, eq. (67) / eq. (72), N·m."""
     periodic_disturbance_fraction: float = 0.2
     """The 1/5 of eq. (68): d_uni scales the constant torque's components."""
