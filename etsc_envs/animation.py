@@ -26,12 +26,11 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-import pettingzoo
 from PIL import Image
 
 import etsc_envs
 from etsc_envs.core.render import RENDER_FPS
-from etsc_envs.triggers import PAPER_TRIGGERS
+from etsc_envs.papers import paper_of
 
 GIF_DIR = Path("docs/envs")
 """Where the command writes, relative to the working directory (the checkout's root)."""
@@ -98,7 +97,7 @@ def gym_frames(env: Any, policy: Any, frames: int = FRAMES, warp: float = WARP) 
 
 
 def parallel_frames(
-    env: pettingzoo.ParallelEnv, policy: Any, frames: int = FRAMES, warp: float = WARP
+    env: Any, policy: Any, frames: int = FRAMES, warp: float = WARP
 ) -> list[np.ndarray]:
     """Frames of one episode of a PettingZoo env of the suite (``render_mode="rgb_array"``,
     reset with seed 0) in which every agent acts by ``policy.predict`` on its own observation
@@ -150,7 +149,8 @@ def paper_gif(env_id: str, out_dir: str | Path, frames: int = FRAMES) -> Path:
     """The GIF of ``env_id`` under the paper's trigger (the scenario of :data:`SCENARIOS`, else
     the paper's), written to ``out_dir``/:func:`gif_name`."""
     kwargs = {"render_mode": "rgb_array", **SCENARIOS.get(env_id, {})}
-    trigger_class = PAPER_TRIGGERS[env_id]
+    trigger_class = paper_of(env_id).trigger
+    env: Any  # the suite's env class, which make_parallel and gym.make type as their bases
     if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env = etsc_envs.make_parallel(env_id, **kwargs)
         agent = env.possible_agents[0]

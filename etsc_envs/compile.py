@@ -33,7 +33,9 @@ from tqdm import tqdm
 
 import etsc_envs
 from etsc_envs.core.compiled_loop import always_accepts
-from etsc_envs.triggers import ERROR_TIME_TRIGGERS, PAPER_TRIGGERS, ClockTrigger
+from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.papers import paper_of
+from etsc_envs.triggers import ClockTrigger
 from etsc_envs.triggers.base import RuleTrigger
 from etsc_envs.triggers.family import FamilyPoint, family_trigger_class
 
@@ -59,22 +61,23 @@ RuleBuilder = Callable[[gym.Env], RuleTrigger]
 
 def rule_triggers(env_id: str) -> dict[str, RuleBuilder]:
     """The rules of ``env_id`` that the compiled loop runs, by name: the paper's rule, its
-    error-time rule where it has one (:data:`~etsc_envs.triggers.ERROR_TIME_TRIGGERS`), its
+    error-time rule where it has one (:attr:`~etsc_envs.core.paper.Paper.error_time`), its
     parametric family (:mod:`etsc_envs.triggers.family`) and the clock (where the receiver
     takes every transmission, as ``--policy periodic`` then runs the clock rule)."""
-    paper = PAPER_TRIGGERS[env_id]
+    record = paper_of(env_id)
+    paper = record.trigger
     builders: dict[str, RuleBuilder] = {"paper rule": lambda env: paper(*_spaces(env))}
-    if env_id in ERROR_TIME_TRIGGERS:
-        error_time = ERROR_TIME_TRIGGERS[env_id]
+    if record.error_time is not None:
+        error_time = record.error_time.trigger
         builders["error-time rule"] = lambda env: error_time(*_spaces(env))
     if paper.condition is not None:
         family = family_trigger_class(paper)
         builders["trigger family"] = lambda env: family(
-            *_spaces(env), point=FamilyPoint(), sampling_period_s=env.unwrapped.sampling_period_s
+            *_spaces(env), point=FamilyPoint(), sampling_period_s=_loop(env).sampling_period_s
         )
     if env_id not in etsc_envs.PETTINGZOO_ENV_IDS and _takes_every_transmission(env_id):
         builders["clock"] = lambda env: ClockTrigger(
-            *_spaces(env), every=CLOCK_EVERY, sampling_period_s=env.unwrapped.sampling_period_s
+            *_spaces(env), every=CLOCK_EVERY, sampling_period_s=_loop(env).sampling_period_s
         )
     return builders
 
@@ -103,21 +106,31 @@ def _all_ids() -> list[str]:
     return [*etsc_envs.ENV_IDS, *etsc_envs.PETTINGZOO_ENV_IDS]
 
 
+def _loop(env: gym.Env) -> EventTriggeredEnv:
+    """The closed loop under ``env``'s wrappers (``TypeError`` for an env not of the suite)."""
+    loop = env.unwrapped
+    if not isinstance(loop, EventTriggeredEnv):
+        raise TypeError(f"env must wrap an EventTriggeredEnv, got {type(loop).__name__}")
+    return loop
+
+
 def _spaces(env: gym.Env) -> tuple[gym.Space, gym.Space, tuple[str, ...]]:
-    return env.observation_space, env.action_space, tuple(env.unwrapped.observation_names)
+    return env.observation_space, env.action_space, tuple(_loop(env).observation_names)
 
 
 def _takes_every_transmission(env_id: str) -> bool:
     """Whether the receiver of ``env_id`` takes every transmission (else a clock is a counter,
     not a rule: paper 003's burst refuses transmissions)."""
-    env_class = load_env_creator(gym.spec(env_id).entry_point)
+    env_class = load_env_creator(str(gym.spec(env_id).entry_point))
+    if not (isinstance(env_class, type) and issubclass(env_class, EventTriggeredEnv)):
+        raise TypeError(f"{env_id} is not an EventTriggeredEnv")
     return env_class.kernels.accepts is always_accepts
 
 
 def _actions(space: gym.Space, transmit: bool) -> Any:
     if isinstance(space, gym.spaces.Discrete):
         return int(transmit)
-    return np.full(space.shape, int(transmit), dtype=np.int64)
+    return np.full(space.shape or (), int(transmit), dtype=np.int64)
 
 
 def _single_step(env_id: str) -> Callable[[], None]:
@@ -127,7 +140,7 @@ def _single_step(env_id: str) -> Callable[[], None]:
             env.reset(seed=0)
             for instant in range(INSTANTS):
                 env.step(_actions(env.action_space, instant == 0))
-            unwrapped = env.unwrapped
+            unwrapped = _loop(env)
             unwrapped.run_interval(_actions(env.action_space, True), INSTANTS)
             unwrapped.episode_metrics()
             env.close()
@@ -164,7 +177,7 @@ def _rule_runs(env_id: str, build: RuleBuilder) -> Callable[[], None]:
         trigger = build(env)
         trigger.predict(observation)
         trigger.predict(np.stack([observation, observation]))
-        unwrapped = env.unwrapped
+        unwrapped = _loop(env)
         unwrapped.run_rule_interval(trigger, INSTANTS)
         unwrapped.run_rule_interval(trigger, INSTANTS, send_first=True)
         env.close()

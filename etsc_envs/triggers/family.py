@@ -544,11 +544,12 @@ class LearnedTrigger:
         sampling_period_s: float,
     ) -> RuleTrigger:
         """The trigger policy of this point for an env of these spaces and names."""
-        from etsc_envs.triggers import FAMILY_CLASSES
+        from etsc_envs.papers import PAPERS  # the records import the trigger modules
 
-        if self.family not in FAMILY_CLASSES:
-            raise ValueError(f"family must be one of {sorted(FAMILY_CLASSES)}, got {self.family!r}")
-        trigger_class = family_trigger_class(FAMILY_CLASSES[self.family])
+        families = {paper.trigger.__name__: paper.trigger for paper in PAPERS}
+        if self.family not in families:
+            raise ValueError(f"family must be one of {sorted(families)}, got {self.family!r}")
+        trigger_class = family_trigger_class(families[self.family])
         return trigger_class(
             observation_space,
             action_space,
