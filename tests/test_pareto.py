@@ -9,7 +9,8 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.judge.pareto import PAPER_SWEEPS, RULE_SWEEPS, main, non_dominated, periodic_sweep
+from agents.judge.pareto import main, non_dominated
+from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.triggers.attitude_tracking import PAPER_PSI
 
 
@@ -21,10 +22,10 @@ def test_pareto_writes_the_curves_with_intervals_and_the_paper_scenario(tmp_path
     assert (out_dir / "pareto.png").stat().st_size > 0
     assert (result["scenarios"], result["set_size"]) == ("test", 3)
     curves = result["curves"]
-    assert len(curves["paper"]) == len(PAPER_SWEEPS["etsc/AttitudeTracking-v0"]())
+    assert len(curves["paper"]) == len(paper_of("etsc/AttitudeTracking-v0").rule.sweep())
     assert any(point["args"] == {"psi": PAPER_PSI} for point in curves["paper"])
     periods = [point["args"]["every"] for point in curves["periodic"]]
-    assert periods == list(periodic_sweep("etsc/AttitudeTracking-v0"))
+    assert periods == list(paper_of("etsc/AttitudeTracking-v0").periodic_every)
     assert curves["learned"] == []
     steps = 300
     for point in curves["periodic"]:
@@ -45,9 +46,8 @@ def test_an_id_with_an_error_time_rule_gets_its_curve_and_reuse_keeps_it(tmp_pat
     assert main([*argv, "--out", str(first)]) == 0
     result = json.loads((first / "pareto.json").read_text(encoding="utf-8"))
     curve = result["curves"]["error_time"]
-    assert [point["args"] for point in curve] == RULE_SWEEPS["error_time"][
-        "etsc/InnerFormation-v0"
-    ]()
+    expected = paper_of("etsc/InnerFormation-v0").rules["error_time"].sweep()
+    assert [point["args"] for point in curve] == expected
     counts = [point["transmissions"]["mean"] for point in curve]
     assert counts == sorted(counts, reverse=True) and counts[0] > counts[-1], "a larger A waits"
     second = tmp_path / "second"
@@ -66,12 +66,12 @@ def test_the_front_keeps_only_non_dominated_points() -> None:
     assert [(p["sent"], p["cost"]) for p in front] == [(5, 3.0), (10, 1.0), (20, 0.5), (40, 0.4)]
 
 
-@pytest.mark.parametrize("env_id", sorted(PAPER_SWEEPS))
+@pytest.mark.parametrize("env_id", PAPER_IDS)
 def test_every_sweep_is_accepted_by_its_paper_trigger(env_id: str) -> None:
     from baselines.cli import episode_setup
 
     setup = episode_setup(env_id, {})
-    for args in PAPER_SWEEPS[env_id]():
+    for args in paper_of(env_id).rule.sweep():
         setup.make_policy("paper", args)
     setup.env.close()
 

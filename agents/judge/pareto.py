@@ -10,12 +10,14 @@ under the test protocol.
 Every point of three curves runs on a scenario set of the protocol (default the test set, all
 its scenarios at once in the native vector env) and on the paper scenario:
 
-* the paper's trigger over a sweep of its threshold (:data:`PAPER_SWEEPS`: Ψ for 002, γ1 and
-  γ2 for 000, c for 001, α for 003, Π for 004), the paper's own value included;
-* on ids with another event rule (:data:`RULE_SWEEPS`: 004's error-time rule), that rule over
-  a sweep of its threshold, as a curve of its own;
-* periodic transmission every ``k`` sampling instants (:func:`periodic_sweep`), wide enough
-  to reach periods at which the clock fails;
+* the paper's trigger over a sweep of its threshold (the paper record's
+  :meth:`~etsc_envs.core.paper.Rule.sweep`: Ψ for 002, γ1 and γ2 for 000, c for 001, α for
+  003, Π for 004), the paper's own value included;
+* on ids with another event rule (the record's other :attr:`~etsc_envs.core.paper.Paper.rules`:
+  004's error-time rule), that rule over a sweep of its threshold, as a curve of its own;
+* periodic transmission every ``k`` sampling instants (the record's
+  :attr:`~etsc_envs.core.paper.Paper.periodic_every`), wide enough to reach periods at which
+  the clock fails;
 * each ``--model`` (an SB3 zip, with its observation statistics beside it if it has them),
   typically one per transmission penalty λ, and the model of every finished trial of each
   ``--sweep`` (the results folder of ``python -m agents.sweep``: a front in one option). The
@@ -76,68 +78,8 @@ from baselines.cli import (
 from baselines.evaluate import evaluate, positive_integer
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
+from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import DEFAULT_SET_SIZE
-from etsc_envs.triggers import ERROR_TIME_THRESHOLDS, PAPER_THRESHOLDS
-
-SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
-"""Multiples of the paper's threshold swept where the threshold is a free positive number."""
-
-
-def _scaled(
-    env_id: str, scales: tuple[float, ...] = SCALES, thresholds: dict = PAPER_THRESHOLDS
-) -> list[dict[str, float]]:
-    """The threshold keywords of ``env_id``'s trigger (``thresholds``, by default the paper's,
-    :data:`PAPER_THRESHOLDS`) at each multiple of ``scales`` of their default values."""
-    values = thresholds[env_id]()
-    return [{name: scale * value for name, value in values.items()} for scale in scales]
-
-
-def _cluster_sweep() -> list[dict[str, float]]:
-    return [{"c": c} for c in (0.2, 0.4, 0.6, 0.8, 0.95)]
-
-
-PAPER_SWEEPS = {
-    "etsc/AttitudeTracking-v0": lambda: _scaled("etsc/AttitudeTracking-v0"),
-    "etsc/OrbitAttitudeTracking-v0": lambda: _scaled(
-        "etsc/OrbitAttitudeTracking-v0", (0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
-    ),
-    "etsc/ClusterContainmentCentral-v0": _cluster_sweep,
-    "etsc/ClusterContainment-v0": _cluster_sweep,
-    # Paper 003 fires its fewest bursts near alpha / 16 (validation set, docs/results.md): the
-    # sweep reaches below it and up to 4 alpha, where the orbit leaves the shell.
-    "etsc/AsteroidOrbitKeeping-v0": lambda: _scaled(
-        "etsc/AsteroidOrbitKeeping-v0", (1 / 64, 1 / 16, 1 / 4, 1.0, 4.0)
-    ),
-    "etsc/InnerFormation-v0": lambda: _scaled("etsc/InnerFormation-v0"),
-}
-"""Id → the paper-trigger arguments of each point (the paper's own values among them)."""
-
-RULE_SWEEPS = {
-    "error_time": {
-        "etsc/InnerFormation-v0": lambda: _scaled(
-            "etsc/InnerFormation-v0", (0.5, 1.0, 2.0, 4.0, 8.0, 16.0), ERROR_TIME_THRESHOLDS
-        ),
-    },
-}
-"""Policy name (``--policy``) → id → the arguments of each point of that rule's curve."""
-
-PERIODIC_EVERY = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000)
-"""Sampling instants between periodic transmissions."""
-
-PERIODIC_EVERY_BY_ID = {
-    # A burst fires for 50 s = 200 sampling instants, so requests closer than that all land
-    # inside a running burst: periodic bursts start 200 instants apart at the closest.
-    "etsc/AsteroidOrbitKeeping-v0": (200, 240, 300, 400, 600, 800, 1200, 1600, 2400, 4800),
-    # The paper's trigger updates a follower every few seconds (hundreds of 0.01-s instants).
-    "etsc/ClusterContainmentCentral-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000, 10000),
-    "etsc/ClusterContainment-v0": (10, 50, 100, 200, 500, 1000, 2000, 5000, 10000),
-}
-"""Ids whose periodic sweep differs from :data:`PERIODIC_EVERY`."""
-
-
-def periodic_sweep(env_id: str) -> tuple[int, ...]:
-    """Sampling instants between periodic transmissions swept for ``env_id``."""
-    return PERIODIC_EVERY_BY_ID.get(env_id, PERIODIC_EVERY)
 
 
 def run_point(
@@ -242,8 +184,7 @@ def pareto(
     methods = list(methods) if methods is not None else [LEARNED] * len(models)
     if len(methods) != len(models):
         raise ValueError(f"methods: one per model ({len(models)}), got {len(methods)}")
-    if env_id not in PAPER_SWEEPS:
-        raise ValueError(f"no Pareto sweep for {env_id}; known: {sorted(PAPER_SWEEPS)}")
+    paper = paper_of(env_id)
     if scenarios not in ("test", "validation"):
         raise ValueError(f"--scenarios must be 'test' or 'validation', got {scenarios!r}")
     identity = (closed_loop_id(env_id), env_kwargs, scenarios, set_size)
@@ -271,15 +212,15 @@ def pareto(
 
     if reuse is None:
         curves = {
-            "paper": [point("paper", args) for args in PAPER_SWEEPS[env_id]()],
-            "periodic": [point("periodic", {"every": k}) for k in periodic_sweep(env_id)],
+            "paper": [point("paper", args) for args in paper.rule.sweep()],
+            "periodic": [point("periodic", {"every": k}) for k in paper.periodic_every],
         }
     else:
         curves = {name: reuse["curves"][name] for name in ("paper", "periodic")}
-    for name, sweeps in RULE_SWEEPS.items():
-        if env_id in sweeps:
+    for name, rule in paper.rules.items():
+        if name != "paper":
             earlier = None if reuse is None else reuse["curves"].get(name)
-            curves[name] = earlier or [point(name, args) for args in sweeps[env_id]()]
+            curves[name] = earlier or [point(name, args) for args in rule.sweep()]
     if menu:
         curves["hand_menu"] = [
             point
@@ -527,7 +468,7 @@ def main(argv: list[str] | None = None) -> int:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("env_id", choices=sorted(PAPER_SWEEPS))
+    parser.add_argument("env_id", choices=PAPER_IDS)
     parser.add_argument(
         "--model",
         action="append",
