@@ -47,7 +47,7 @@ from etsc_envs import cluster_containment_v0
 from etsc_envs.cluster.closed_loop import integrate_loop
 from etsc_envs.cluster.controller import regressor
 from etsc_envs.cluster.dynamics import attitude_rate
-from etsc_envs.cluster.env import FEATURE_NAMES, cluster_model, hull_distance
+from etsc_envs.cluster.env import FEATURE_NAMES, cluster_model
 from etsc_envs.cluster.params import (
     FIGURE_2_EDGES,
     FIGURE_5_CELLS,
@@ -58,6 +58,7 @@ from etsc_envs.cluster.params import (
 from etsc_envs.cluster.topology import (
     adjacency_from_edges,
     containment_weights,
+    hull_distance,
     is_pi1_partition,
     reachable_from,
     validate_adjacency,

@@ -35,7 +35,7 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
 Keys of ``overrides``, ``grid`` and ``search`` are training-config keys, dotted to reach into
 a mapping: ``seed``, ``total_timesteps``, ``env_kwargs.transmission_penalty``,
 ``hyperparameters.learning_rate``. Paths (``base``, ``results_dir``, the training config's
-``init_from``, ``imitation_selection_cache``) are relative to the current folder, as in
+``init_from``, ``start_from.selection_cache``) are relative to the current folder, as in
 ``agents.train``.
 
 Every problem raises a one-line ``ValueError`` naming the key and what it allows.
@@ -54,7 +54,7 @@ from typing import Any
 
 import yaml
 
-from agents.sweep.results import EVALUATION_METRICS, METRICS, TRIALS_DIR
+from agents.sweep.results import EVALUATION_METRICS, METRICS, SETTINGS_FILE, TRIALS_DIR
 from agents.train.config import (
     OPTIONAL_DEFAULTS,
     REQUIRED_KEYS,
@@ -62,6 +62,7 @@ from agents.train.config import (
     config_from_dict,
     require_key_set,
 )
+from etsc_envs.core.files import atomic_write_text
 
 KINDS = ("front", "search")
 SCHEDULERS = ("asha",)
@@ -83,7 +84,7 @@ OPTIONAL_SWEEP_DEFAULTS: dict[str, Any] = {
     "cpus_per_trial": 1,
     "max_concurrent_trials": None,
 }
-NESTED_TRAINING_KEYS = ("env_kwargs", "hyperparameters", "evaluation_env_kwargs")
+NESTED_TRAINING_KEYS = ("env_kwargs", "hyperparameters", "evaluation_env_kwargs", "start_from")
 """Training-config keys whose value is a mapping that a dotted key may reach into."""
 
 TUNE_DIR = "tune"
@@ -160,6 +161,35 @@ class SweepConfig:
         """Where the trial called ``name`` writes its training outputs."""
         return self.trials_dir / name
 
+    def start_or_continue(self, resume: bool, started: bool) -> None:
+        """Refuse to start over a sweep that has ``started`` (``--resume`` continues it, with
+        the settings it started with); record a new sweep's settings in ``sweep_settings.json``.
+
+        A resumed sweep runs the trials it planned when it started, so ``--resume`` with
+        changed settings is refused (they would mislabel the trials)."""
+        path = Path(self.results_dir) / SETTINGS_FILE
+        now = json.dumps(self.settings(), indent=2, sort_keys=True) + "\n"
+        if not resume:
+            if started:
+                raise ValueError(
+                    f"results_dir {self.results_dir!r} already holds a sweep: continue it with "
+                    f"--resume or choose another results_dir"
+                )
+            atomic_write_text(path, now)
+            return
+        if not started:
+            raise ValueError(f"--resume: no sweep in {self.results_dir!r} to continue")
+        if not path.is_file():
+            return
+        before = json.loads(path.read_text(encoding="utf-8"))
+        after = json.loads(now)
+        changed = sorted(key for key in {*before, *after} if before.get(key) != after.get(key))
+        if changed:
+            raise ValueError(
+                f"--resume: the sweep's {changed} changed since it started (see {str(path)!r}); "
+                f"resume it with the settings it started with, or start another results_dir"
+            )
+
     def trial_config(self, values: Mapping[str, Any], out_dir: str | Path) -> TrainConfig:
         """The validated training config of the trial with the swept ``values``."""
         raw = copy.deepcopy(self.base)
@@ -190,8 +220,9 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
         _assign(base, key, value)
     base["out_dir"] = "<trial folder>"
     base["init_from"] = _absolute(base.get("init_from"))
-    if "imitation_selection_cache" in base:  # sweeps written before the key keep their settings
-        base["imitation_selection_cache"] = _absolute(base["imitation_selection_cache"])
+    start_from = base.get("start_from")
+    if isinstance(start_from, dict) and "selection_cache" in start_from:
+        start_from["selection_cache"] = _absolute(start_from["selection_cache"])
     grid = _check_grid(values["grid"])
     search = _check_search(values["search"])
     overlap = sorted(set(grid) & set(search))

@@ -19,14 +19,11 @@ from __future__ import annotations
 import dataclasses
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from etsc_envs.core.files import atomic_write_text
-
-if TYPE_CHECKING:  # agents.sweep.config imports this module
-    from agents.sweep.config import SweepConfig
 
 SUMMARY_FILE = "sweep_summary.json"
 SETTINGS_FILE = "sweep_settings.json"
@@ -215,39 +212,3 @@ def one_line_error(error: BaseException) -> str:
     cause = getattr(error, "cause", None) or error
     lines = str(cause).strip().splitlines()
     return f"{type(cause).__name__}: {lines[0]}" if lines else type(cause).__name__
-
-
-def start_or_continue(sweep: SweepConfig, resume: bool, started: bool) -> None:
-    """Refuse to start over a sweep that has ``started`` (``--resume`` continues it, with the
-    settings it started with); record a new sweep's settings in ``sweep_settings.json``."""
-    if resume:
-        if not started:
-            raise ValueError(f"--resume: no sweep in {sweep.results_dir!r} to continue")
-        _check_unchanged(sweep)
-        return
-    if started:
-        raise ValueError(
-            f"results_dir {sweep.results_dir!r} already holds a sweep: continue it with --resume "
-            f"or choose another results_dir"
-        )
-    atomic_write_text(Path(sweep.results_dir) / SETTINGS_FILE, _settings_json(sweep))
-
-
-def _settings_json(sweep: SweepConfig) -> str:
-    return json.dumps(sweep.settings(), indent=2, sort_keys=True) + "\n"
-
-
-def _check_unchanged(sweep: SweepConfig) -> None:
-    """``ValueError`` if the sweep's settings differ from those it started with (a resumed
-    sweep runs the trials it planned then; changed settings would mislabel them)."""
-    path = Path(sweep.results_dir) / SETTINGS_FILE
-    if not path.is_file():
-        return
-    started = json.loads(path.read_text(encoding="utf-8"))
-    now = json.loads(_settings_json(sweep))
-    changed = sorted(key for key in {*started, *now} if started.get(key) != now.get(key))
-    if changed:
-        raise ValueError(
-            f"--resume: the sweep's {changed} changed since it started (see {str(path)!r}); "
-            f"resume it with the settings it started with, or start another results_dir"
-        )

@@ -46,7 +46,6 @@ from agents.sweep.results import (
     SweepTrial,
     final_scores,
     one_line_error,
-    start_or_continue,
     trial_status,
     write_summary,
 )
@@ -207,7 +206,7 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
         raise ValueError(f"--resume: no saved sweep in {str(sweep.tune_dir)!r} to continue")
     if address is not None:
         check_reachable(address)
-    start_or_continue(sweep, resume, sweep.tune_dir.exists() or sweep.trials_dir.exists())
+    sweep.start_or_continue(resume, sweep.tune_dir.exists() or sweep.trials_dir.exists())
     connect(address)
     try:
         results = build_tuner(sweep, resume).fit()

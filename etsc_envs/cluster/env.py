@@ -12,7 +12,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.optimize import nnls
 
 from etsc_envs.cluster.closed_loop import (
     CONVERGENCE_FRACTION,
@@ -42,7 +41,7 @@ from etsc_envs.cluster.closed_loop import (
 from etsc_envs.cluster.dynamics import ClusterModel
 from etsc_envs.cluster.params import ClusterContainmentParams, replace_params
 from etsc_envs.cluster.picture import PICTURE
-from etsc_envs.cluster.topology import containment_targets
+from etsc_envs.cluster.topology import containment_targets, hull_distance
 from etsc_envs.core.keywords import document_keywords
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.multi_agent import agent_major_names, agent_metrics
@@ -111,18 +110,6 @@ def cluster_model(params: ClusterContainmentParams, disturbance_phase: np.ndarra
         torque_limit=float(params.torque_limit),
         targets=containment_targets(params.adjacency, params.leader_attitudes),
     )
-
-
-def hull_distance(point: np.ndarray, vertices: np.ndarray) -> float:
-    """Euclidean distance from ``point`` to the convex hull of ``vertices`` (Definition 4).
-
-    Minimises ‖Σ λ_j x_j - point‖ over λ ≥ 0 with Σ λ_j = 1, the sum enforced by a heavily
-    weighted extra row of a non-negative least-squares problem.
-    """
-    weight = 1e4
-    matrix = np.vstack([vertices.T, weight * np.ones(len(vertices))])
-    weights, _ = nnls(matrix, np.append(point, weight))
-    return float(np.linalg.norm(vertices.T @ weights - point))
 
 
 @document_keywords(ClusterContainmentParams)

@@ -20,6 +20,7 @@ from matplotlib.gridspec import SubplotSpec
 from scipy.spatial import ConvexHull, QhullError
 
 from etsc_envs.cluster.closed_loop import PLANT, follower_table
+from etsc_envs.cluster.topology import hull_distance
 from etsc_envs.core.render import SystemPicture, bare_axes
 
 TILT_DEG = 35.0
@@ -61,8 +62,6 @@ def hull_edges(leaders: np.ndarray) -> list[tuple[int, int]]:
 
 def draw(env: Any, figure: Figure, region: SubplotSpec, trail: np.ndarray) -> None:
     """Hull, leaders, targets, the followers' trails and attitudes."""
-    from etsc_envs.cluster.env import hull_distance  # the env module imports this one
-
     leaders = np.asarray(env.params.leader_attitudes, dtype=float)
     targets = env.targets
     n = len(targets)

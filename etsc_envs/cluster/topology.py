@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 import numpy as np
+from scipy.optimize import nnls
 
 from etsc_envs.core.validation import require_float_array
 
@@ -125,3 +126,15 @@ def is_pi1_partition(adjacency: np.ndarray, cells: Sequence[Sequence[int]]) -> b
             if not np.allclose(counts, counts[0], rtol=0.0, atol=1e-12):
                 return False
     return True
+
+
+def hull_distance(point: np.ndarray, vertices: np.ndarray) -> float:
+    """Euclidean distance from ``point`` to the convex hull of ``vertices`` (Definition 4).
+
+    Minimises ‖Σ λ_j x_j - point‖ over λ ≥ 0 with Σ λ_j = 1, the sum enforced by a heavily
+    weighted extra row of a non-negative least-squares problem.
+    """
+    weight = 1e4
+    matrix = np.vstack([vertices.T, weight * np.ones(len(vertices))])
+    weights, _ = nnls(matrix, np.append(point, weight))
+    return float(np.linalg.norm(vertices.T @ weights - point))
