@@ -106,20 +106,29 @@ def load_policy(path: str, env: Any) -> Any:
     a PettingZoo parallel env, whose agents then share the policy), answering
     ``predict(obs, state=None, episode_start=None, deterministic=True)`` like an SB3 model.
 
-    Reads a learned trigger (``learned.json`` of ``python -m agents.search``, or a ``learned:``
-    prefix before its path): :class:`~etsc_envs.triggers.family.LearnedTrigger`. Raises
-    ``ValueError`` naming ``path`` for anything else; SB3 zips load with the checkout's
-    ``baselines.policies.load_sb3``, which needs the ``train`` extra.
-    """
-    from etsc_envs.triggers.family import LearnedTrigger
+    Reads
 
-    path = str(path).removeprefix("learned:")
-    if not path.endswith(".json"):
-        raise ValueError(
-            f"path: load_policy reads learned triggers (.json), got {path!r}; SB3 zips load "
-            "with baselines.policies.load_sb3 in the checkout"
-        )
-    return LearnedTrigger.load(path).policy_for(env)
+    * a learned trigger (``learned.json`` of ``python -m agents.search``, or a ``learned:``
+      prefix before its path): :class:`~etsc_envs.triggers.family.LearnedTrigger`;
+    * a Stable-Baselines3 model (``NAME.zip``, or an ``sb3:`` prefix before its path), with
+      the observation statistics beside it (:func:`etsc_envs.sb3_models.load_sb3_policy`;
+      needs the ``train`` extra).
+
+    Raises ``ValueError`` naming ``path`` for any other file.
+    """
+    path = str(path)
+    if path.removeprefix("learned:").endswith(".json"):
+        from etsc_envs.triggers.family import LearnedTrigger
+
+        return LearnedTrigger.load(path.removeprefix("learned:")).policy_for(env)
+    if path.removeprefix("sb3:").endswith(".zip"):
+        from etsc_envs.sb3_models import load_sb3_policy
+
+        return load_sb3_policy(path.removeprefix("sb3:"), env)
+    raise ValueError(
+        f"path: load_policy reads learned triggers (.json) and Stable-Baselines3 models (.zip), "
+        f"got {path!r}"
+    )
 
 
 __version__ = "0.1.0"

@@ -273,4 +273,4 @@ def test_load_policy_runs_a_learned_file_from_the_package(tmp_path) -> None:
         assert action == direct.predict(obs)[0]
         obs, *_ = env.step(action)
     with pytest.raises(ValueError, match="path"):
-        etsc_envs.load_policy(str(tmp_path / "model.zip"), env)
+        etsc_envs.load_policy(str(tmp_path / "model.pkl"), env)

@@ -628,7 +628,7 @@ def test_a_model_interrupted_while_being_written_is_written_whole(
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
     from agents.train.model_files import write_model
-    from baselines.policies import normalization_path
+    from etsc_envs.sb3_models import normalization_path
 
     env = VecNormalize(DummyVecEnv([lambda: gym.make(GYM_IDS[0], **SHORT[GYM_IDS[0]])]))
     model = PPO("MlpPolicy", env, n_steps=64, batch_size=64, device="cpu")
@@ -854,7 +854,7 @@ def test_a_pickle_planted_in_a_models_data_record_is_not_run(tmp_path: Path, cap
     assert "planted.zip" in line and "pickled ['extra']" in line, line
     assert not marker.exists()
     # without the unknown entry the model loads, and still nothing ran
-    from baselines.policies import load_sb3
+    from etsc_envs.sb3_models import load_sb3
 
     with zipfile.ZipFile(model) as archive:
         record = json.loads(archive.read("data"))
@@ -886,7 +886,7 @@ def test_the_converter_keeps_the_statistics_exactly(tmp_path: Path) -> None:
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
     from agents.train.convert_statistics import convert
-    from baselines.policies import ObservationStatistics
+    from etsc_envs.sb3_models import ObservationStatistics
 
     env_id = GYM_IDS[0]
     live = VecNormalize(DummyVecEnv([lambda: gym.make(env_id, **SHORT[env_id])]))

@@ -11,7 +11,7 @@ pytest.importorskip("stable_baselines3")
 
 import etsc_envs
 from baselines.evaluate import evaluate
-from baselines.policies import NormalizedModel, load_sb3, normalization_path
+from etsc_envs.sb3_models import NormalizedModel, load_sb3, normalization_path
 
 ROOT = Path(__file__).parents[1]
 MODELS = sorted((ROOT / "models").glob("*-v0_*.zip"))

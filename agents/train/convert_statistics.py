@@ -8,7 +8,7 @@ unpickler knows only the classes a ``VecNormalize`` save holds (``VecNormalize``
 ``RunningMeanStd``, Gymnasium's spaces, NumPy's arrays and random generators), and builds each
 as an inert record of its state instead of the class itself; any other name refuses the file.
 From the records it takes the running means, variances and counts and the settings, checks
-them (:meth:`baselines.policies.ObservationStatistics.read`'s checks) and writes
+them (:meth:`etsc_envs.sb3_models.ObservationStatistics.read`'s checks) and writes
 ``NAME_vecnormalize.npz`` beside the pickle, which it then removes.
 """
 
@@ -24,12 +24,12 @@ from typing import Any
 
 import numpy as np
 
-from baselines.policies import (
+from etsc_envs.core.files import atomic_write_bytes
+from etsc_envs.sb3_models import (
     LEGACY_NORMALIZATION_SUFFIX,
     NORMALIZATION_SUFFIX,
     ObservationStatistics,
 )
-from etsc_envs.core.files import atomic_write_bytes
 
 
 class _Record:
