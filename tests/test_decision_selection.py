@@ -1,5 +1,5 @@
 """Choosing the decision a self-triggered run starts from, per transmission penalty
-(``imitation_decision: best``, :mod:`agents.train.decision_selection`)."""
+(``start_from.decision: best``, :mod:`agents.train.decision_selection`)."""
 
 from __future__ import annotations
 
@@ -104,7 +104,7 @@ def test_runs_that_differ_in_lambda_alone_share_the_candidates_runs(tmp_path):
 
 def test_an_unknown_candidate_is_refused_by_name():
     decisions = DecisionSet(ATTITUDE, max_exponent=3)
-    with pytest.raises(ValueError, match="imitation_candidates: 'hold 64'"):
+    with pytest.raises(ValueError, match=r"start_from\.candidates: 'hold 64'"):
         select_decision(ATTITUDE, SHORT, decisions, SET_SIZE, ["hold 1", "hold 64"])
 
 
@@ -115,38 +115,43 @@ BASE_CONFIG = {
     "policy": "MlpPolicy",
     "total_timesteps": 32,
     "decisions": {"max_exponent": 3, "factors": [1.0, 4.0]},
-    "imitation_steps": 64,
 }
 
 
 @pytest.mark.parametrize(
-    ("changes", "message"),
+    ("start_from", "message"),
     [
         (
-            {"imitation_decision": "hold 1", "imitation_candidates": ["hold 1"]},
-            "'imitation_candidates' needs 'imitation_decision: best'",
+            {"decision": "hold 1", "candidates": ["hold 1"]},
+            "'start_from.candidates' needs 'start_from.decision: best'",
         ),
         (
-            {"imitation_decision": "best", "imitation_candidates": []},
-            "'imitation_candidates' must be a non-empty list",
+            {"decision": "best", "candidates": []},
+            "'start_from.candidates' must be a non-empty list",
         ),
         (
-            {"imitation_decision": "best", "imitation_candidates": ["hold 64"]},
-            "'imitation_candidates': 'hold 64' is not a decision of this set",
+            {"decision": "best", "candidates": ["hold 64"]},
+            "'start_from.candidates': 'hold 64' is not a decision of this set",
         ),
         (
-            {"imitation_decision": "hold 1", "imitation_selection_cache": "cache"},
-            "'imitation_selection_cache' needs 'imitation_decision: best'",
+            {"decision": "hold 1", "selection_cache": "cache"},
+            "'start_from.selection_cache' needs 'start_from.decision: best'",
         ),
     ],
 )
-def test_the_config_checks_the_candidates(tmp_path, changes, message):
+def test_the_config_checks_the_candidates(tmp_path, start_from, message):
     with pytest.raises(ValueError, match=message):
-        config_from_dict({**BASE_CONFIG, "out_dir": str(tmp_path / "run"), **changes})
+        config_from_dict(
+            {
+                **BASE_CONFIG,
+                "out_dir": str(tmp_path / "run"),
+                "start_from": {"steps": 64, **start_from},
+            }
+        )
 
 
 def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path):
-    """``imitation_decision: best`` records the choice beside the model, clones and pins that
+    """``start_from.decision: best`` records the choice beside the model, clones and pins that
     decision, and a resumed run reads it back instead of choosing again."""
     out_dir = tmp_path / "run"
     config = {
@@ -156,11 +161,14 @@ def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path
         "total_timesteps": 32,
         "n_envs": 1,
         "out_dir": str(out_dir),
-        "imitation_decision": "best",
-        "imitation_candidates": CANDIDATES,
-        "imitation_selection_cache": str(tmp_path / "cache"),
-        "imitation_epochs": 5,
-        "imitation_pinned_probability": 0.9,
+        "start_from": {
+            "decision": "best",
+            "steps": 64,
+            "epochs": 5,
+            "pinned_probability": 0.9,
+            "candidates": CANDIDATES,
+            "selection_cache": str(tmp_path / "cache"),
+        },
         "evaluation_scenarios": SET_SIZE,
         "checkpoint_every": 16,
         "tensorboard": False,
@@ -173,7 +181,8 @@ def test_a_best_run_starts_from_the_chosen_decision_and_resumes_with_it(tmp_path
     assert len(list((tmp_path / "cache").iterdir())) == 1
     summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
     assert summary["imitation"]["decision"] == f"{selection['chosen']}, pinned at probability 0.9"
-    assert yaml.safe_load((out_dir / "config.yaml").read_text())["imitation_decision"] == "best"
+    written = yaml.safe_load((out_dir / "config.yaml").read_text())
+    assert written["start_from"]["decision"] == "best"
     (out_dir / "decision_selection.json").write_text(json.dumps({"chosen": "hold 1"}))
     assert main(["--config", str(path), "--resume"]) == 0
     resumed = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))

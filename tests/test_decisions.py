@@ -425,30 +425,35 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ({"decisions": {"shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
         ({"decisions": {"rule": "error_time"}, "env_id": ATTITUDE}, "no error_time rule"),
         ({"decisions": {"rule_keywords": {"b1": 1.0}}}, "config key 'decisions': rule_keywords"),
-        ({"decisions": {}, "imitation_steps": 64}, "imitation_steps"),
-        ({"decisions": {}, "imitation_decision": "hold 1"}, "imitation_steps"),
-        ({"imitation_decision": "hold 1"}, "'imitation_decision' needs the key 'decisions'"),
+        ({"decisions": {}, "start_from": {"steps": 64}}, "'start_from.decision' is required"),
         (
-            {"imitation_pinned_probability": 0.9},
-            "'imitation_pinned_probability' needs the key 'imitation_decision'",
+            {"decisions": {}, "start_from": {"decision": "hold 1"}},
+            r"missing config 'start_from' key\(s\) \['steps'\]",
+        ),
+        (
+            {"decisions": {}, "start_from": {"steps": 8, "decision": "hold 1", "epoch": 3}},
+            r"unknown config 'start_from' key\(s\) \['epoch'\]",
+        ),
+        (
+            {"start_from": {"steps": 8, "decision": "hold 1"}},
+            "'start_from.decision' needs the key 'decisions'",
+        ),
+        (
+            {"start_from": {"steps": 8, "pinned_probability": 0.9}},
+            "'start_from.pinned_probability' needs 'start_from.decision'",
         ),
         (
             {
                 "decisions": {},
-                "imitation_steps": 8,
-                "imitation_decision": "hold 1",
-                "imitation_pinned_probability": 1.0,
+                "start_from": {"steps": 8, "decision": "hold 1", "pinned_probability": 1.0},
             },
-            r"'imitation_pinned_probability' must be a number in \(0, 1\)",
+            r"'start_from.pinned_probability' must be a number in \(0, 1\)",
         ),
         (
-            {
-                "decisions": {"max_exponent": 3},
-                "imitation_steps": 8,
-                "imitation_decision": "hold 64",
-            },
-            r"'imitation_decision': 'hold 64' is not a decision of this set",
+            {"decisions": {"max_exponent": 3}, "start_from": {"steps": 8, "decision": "hold 64"}},
+            r"'start_from.decision': 'hold 64' is not a decision of this set",
         ),
+        ({"imitation_steps": 8}, r"unknown config key\(s\) \['imitation_steps'\]"),
     ],
 )
 def test_training_config_checks_the_decisions(tmp_path, changes, message):
@@ -509,9 +514,7 @@ def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
     out_dir, summary = train_cloned(
         tmp_path,
         **VALIDATED_FORMATION_RUN,
-        imitation_steps=256,
-        imitation_epochs=60,
-        imitation_decision="paper x0.5",
+        start_from={"steps": 256, "epochs": 60, "decision": "paper x0.5"},
     )
     imitation = summary["imitation"]
     assert imitation["decision"] == "paper x0.5" and imitation["steps"] == 256
@@ -531,10 +534,12 @@ def test_the_rule_with_a_heartbeat_trains_pinned_and_deploys(tmp_path):
         env_id=ATTITUDE,
         env_kwargs={"horizon_s": 0.3},
         decisions={"max_exponent": 3, "factors": [8.0], "rule_cap": 12, "rule_heartbeat": True},
-        imitation_steps=128,
-        imitation_epochs=30,
-        imitation_decision="paper x8, heartbeat 12",
-        imitation_pinned_probability=0.9,
+        start_from={
+            "steps": 128,
+            "epochs": 30,
+            "decision": "paper x8, heartbeat 12",
+            "pinned_probability": 0.9,
+        },
     )
     assert summary["imitation"]["decision"] == "paper x8, heartbeat 12, pinned at probability 0.9"
     decisions = DecisionSet.load(out_dir / "model.zip")
@@ -552,10 +557,12 @@ def test_the_error_time_rule_trains_pinned_and_deploys(tmp_path):
         env_id=FORMATION,
         env_kwargs={"horizon_s": 0.3},
         decisions={"max_exponent": 3, "rule": "error_time", "factors": [1.0, 2.0]},
-        imitation_steps=128,
-        imitation_epochs=30,
-        imitation_decision="error_time x2",
-        imitation_pinned_probability=0.9,
+        start_from={
+            "steps": 128,
+            "epochs": 30,
+            "decision": "error_time x2",
+            "pinned_probability": 0.9,
+        },
     )
     assert summary["imitation"]["decision"] == "error_time x2, pinned at probability 0.9"
     assert DecisionSet.load(out_dir / "model.zip").rule == "error_time"
@@ -601,15 +608,12 @@ def test_a_pinned_decision_is_the_policy_everywhere(tmp_path):
 
 
 def test_agents_train_pins_the_cloned_decision(tmp_path):
-    """``imitation_pinned_probability``: the clone's summary records the pin and agrees with the
+    """``start_from.pinned_probability``: the clone's summary records the pin and agrees with the
     decision on every demonstration, and the model validated first is that decision."""
     out_dir, summary = train_cloned(
         tmp_path,
         **VALIDATED_FORMATION_RUN,
-        imitation_steps=64,
-        imitation_epochs=2,
-        imitation_decision="hold 8",
-        imitation_pinned_probability=0.9,
+        start_from={"steps": 64, "epochs": 2, "decision": "hold 8", "pinned_probability": 0.9},
     )
     imitation = summary["imitation"]
     assert imitation["decision"] == "hold 8, pinned at probability 0.9"
@@ -640,10 +644,7 @@ def test_the_decentralised_cluster_trains_pinned_and_deploys(tmp_path):
         env_id=cluster,
         env_kwargs={"horizon_s": 2.0},
         decisions={"max_exponent": 4, "factors": [1.0, 1.5]},
-        imitation_steps=64,
-        imitation_epochs=5,
-        imitation_decision="paper x1.5",
-        imitation_pinned_probability=0.9,
+        start_from={"steps": 64, "epochs": 5, "decision": "paper x1.5", "pinned_probability": 0.9},
     )
     assert summary["imitation"]["decision"] == "paper x1.5, pinned at probability 0.9"
     assert DecisionSet.load(out_dir / "model.zip").env_id == cluster

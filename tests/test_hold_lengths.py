@@ -53,7 +53,7 @@ def test_the_holds_survive_a_save_a_load_and_a_config(tmp_path):
     decisions = DecisionSet(ATTITUDE, factors=(1.0,), holds=HOLDS)
     decisions.save(tmp_path / "model.zip")
     assert DecisionSet.load(tmp_path / "model.zip") == decisions
-    config = {**BASE_CONFIG, "out_dir": str(tmp_path / "run"), "imitation_steps": 0}
+    config = {**BASE_CONFIG, "out_dir": str(tmp_path / "run")}
     config["decisions"] = {"holds": list(HOLDS), "factors": [1.0]}
     config = config_from_dict(config)
     assert config.decisions["holds"] == list(HOLDS)

@@ -118,5 +118,5 @@ def test_a_training_config_takes_the_keywords(tmp_path):
     """(Bad keywords in a config: ``tests/test_decisions.py``.)"""
     decisions = {"factors": [4.0], "rule_floor": 8, "rule_keywords": RELATIVE}
     config = {**BASE_CONFIG, "env_id": ORBIT, "env_kwargs": {"horizon_s": 0.05}}
-    config.update(out_dir=str(tmp_path / "run"), imitation_steps=0, decisions=decisions)
+    config.update(out_dir=str(tmp_path / "run"), decisions=decisions)
     assert config_from_dict(config).decisions["rule_keywords"] == RELATIVE

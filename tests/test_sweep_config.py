@@ -210,8 +210,9 @@ def test_a_selection_cache_folder_is_made_absolute_for_trials_that_run_elsewhere
     monkeypatch.chdir(tmp_path)
     base = ROOT / "configs" / "train" / "attitude_tracking_self_triggered_selected.yaml"
     raw = {**sweep(tmp_path, grid={"seed": [1]}, results_dir="out"), "base": str(base)}
-    raw["overrides"] = {"imitation_selection_cache": "cache"}
+    raw["overrides"] = {"start_from.selection_cache": "cache"}
     config = sweep_config_from_dict(raw)
     trial = config.trial_config(config.grid_points()[0], config.trial_folder("t"))
-    assert trial.imitation_decision == "best"
-    assert trial.imitation_selection_cache == str(tmp_path / "cache")
+    assert trial.start_from is not None
+    assert trial.start_from.decision == "best"
+    assert trial.start_from.selection_cache == str(tmp_path / "cache")

@@ -54,8 +54,8 @@ def tiny_config(out_dir: Path, path: Path = SHIPPED_CONFIG) -> dict[str, Any]:
         evaluation_every=0,
         evaluation_env_kwargs=dict(short),
     )
-    if config.get("imitation_steps"):
-        config["imitation_steps"] = 128
+    if config.get("start_from"):
+        config["start_from"]["steps"] = 128
     config["init_from"] = None  # a later stage's predecessor is not trained here
     return config
 
@@ -225,6 +225,12 @@ def test_init_from_must_be_a_saved_model(tmp_path: Path) -> None:
         config_from_dict(config)
 
 
+def test_init_from_and_start_from_exclude_each_other(tmp_path: Path) -> None:
+    config = tiny_config(tmp_path / "run") | {"init_from": "model.zip", "start_from": {"steps": 8}}
+    with pytest.raises(ValueError, match="'init_from' and 'start_from' exclude each other"):
+        config_from_dict(config)
+
+
 def test_resume_without_checkpoints_is_a_clear_error(tmp_path: Path) -> None:
     config_path = write_config(tiny_config(tmp_path / "run"), tmp_path)
     with pytest.raises(SystemExit):
@@ -246,7 +252,9 @@ def test_config_rejects_dqn_for_a_multibinary_action(tmp_path: Path) -> None:
         ("evaluation_env_kwargs", [1], "'evaluation_env_kwargs' must be a mapping"),
         ("observation_clip", 0, "'observation_clip' must be a positive number"),
         ("torch_threads", 0, "'torch_threads' must be"),
-        ("imitation_steps", -5, "'imitation_steps' must be an integer >= 0"),
+        ("start_from", {"steps": 0}, "'start_from.steps' must be a positive integer"),
+        ("start_from", {"steps": 8, "epochs": 0}, "'start_from.epochs' must be a positive"),
+        ("start_from", [8], "'start_from' must be a mapping"),
     ],
 )
 def test_config_rejects_bad_training_options(tmp_path: Path, key, value, message) -> None:

@@ -41,30 +41,34 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``init_from: null`` — a model saved by an earlier run (``model.zip`` or a checkpoint) to
   start from: its weights and, when saved beside it, its observation and return statistics
   (a curriculum, e.g. short episodes first, then the paper's horizon or another λ); it must
-  have been trained for the observation and action spaces of ``env_id``;
-* ``imitation_steps: 0`` — before reinforcement, run the paper's trigger for that many steps
-  on the training envs and clone it into the policy (and its returns into the value
-  function; :mod:`agents.train.imitation`); 0 starts from a random policy;
-* ``imitation_epochs: 10`` — passes over those steps when cloning;
-* ``imitation_decision: null`` — with ``decisions``, the decision to clone for
-  ``imitation_steps`` decisions instead of the per-instant paper trigger, by its label
-  (``"paper x0.25"``, ``"hold 64"``: :meth:`baselines.self_triggered.DecisionSet.label`;
-  :func:`agents.train.imitation.imitate_decision`); needed with ``decisions`` and
-  ``imitation_steps``, refused without ``decisions``;
-  ``imitation_decision: best`` chooses it per run instead: the decision with the highest mean
-  return on the first ``evaluation_scenarios`` validation scenarios at the run's env kwargs,
-  its transmission penalty among them (:mod:`agents.train.decision_selection`; recorded in
-  ``out_dir/decision_selection.json``), so that each λ of a front starts from its own
-  baseline;
-* ``imitation_candidates: null`` — with ``imitation_decision: best``, the labels it chooses
-  among (``null``: every decision of the set);
-* ``imitation_selection_cache: null`` — with ``imitation_decision: best``, a folder in which
-  runs that differ in their transmission penalty alone (a front's trials) share the
-  candidates' validation runs (:func:`agents.train.decision_selection.select_decision`);
-* ``imitation_pinned_probability: null`` — with ``imitation_decision``, a probability p in
-  (0, 1): after cloning, the policy's action head is set to take the cloned decision with
-  probability p at every observation (:func:`agents.train.imitation.pin_decision`), so that
-  training starts from the fixed decision exactly rather than from a fit of it;
+  have been trained for the observation and action spaces of ``env_id``, and excludes
+  ``start_from``;
+* ``start_from: null`` — before reinforcement, clone a fixed behaviour into the policy (its
+  actions, and its returns into the value function; :mod:`agents.train.imitation`): a mapping
+  of the keys below (:class:`StartFrom`); null starts from a random policy, or from
+  ``init_from``, which it excludes:
+
+  * ``decision`` — with ``decisions`` (and only there; required), the decision to clone, by
+    its label (``"paper x0.25"``, ``"hold 64"``:
+    :meth:`baselines.self_triggered.DecisionSet.label`;
+    :func:`agents.train.imitation.imitate_decision`), or ``best`` to choose it per run: the
+    decision with the highest mean return on the first ``evaluation_scenarios`` validation
+    scenarios at the run's env kwargs, its transmission penalty among them
+    (:mod:`agents.train.decision_selection`; recorded in ``out_dir/decision_selection.json``),
+    so that each λ of a front starts from its own baseline. Without ``decisions`` the
+    per-instant paper trigger is cloned;
+  * ``steps`` — how many steps (with ``decisions``, decisions) of it to run on the training
+    envs and clone (an integer >= 1; required);
+  * ``epochs: 10`` — passes over those steps when cloning;
+  * ``pinned_probability: null`` — with ``decision``, a probability p in (0, 1): after
+    cloning, the policy's action head is set to take the cloned decision with probability p at
+    every observation (:func:`agents.train.imitation.pin_decision`), so that training starts
+    from the fixed decision exactly rather than from a fit of it;
+  * ``candidates: null`` — with ``decision: best``, the labels it chooses among (null: every
+    decision of the set);
+  * ``selection_cache: null`` — with ``decision: best``, a folder in which runs that differ
+    in their transmission penalty alone (a front's trials) share the candidates' validation
+    runs (:func:`agents.train.decision_selection.select_decision`);
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   keywords of :class:`agents.train.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
   ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``, ``rule_floor``,
@@ -72,7 +76,7 @@ A config is a YAML mapping with these keys (the optional ones show their default
   ``hyperparameters.gamma``), on a
   ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
   :class:`agents.train.follower_decisions.FollowerDecisionEnv`; cloning with
-  ``imitation_decision``). PPO, A2C and MaskablePPO then discount by elapsed instants
+  ``start_from.decision``). PPO, A2C and MaskablePPO then discount by elapsed instants
   (:mod:`agents.train.elapsed_discount`); the models are saved with their decision set beside
   them, so that ``sb3:`` deploys them as transmit/hold policies;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
@@ -136,17 +140,101 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "tensorboard": True,
     "torch_threads": 1,
     "init_from": None,
-    "imitation_steps": 0,
-    "imitation_epochs": 10,
-    "imitation_decision": None,
-    "imitation_candidates": None,
-    "imitation_selection_cache": None,
-    "imitation_pinned_probability": None,
+    "start_from": None,
     "decisions": None,
 }
 
 CONFIG_SET_ARGUMENTS = ("policy", "env", "seed")
 """Constructor arguments that come from the config's own keys, not from ``hyperparameters``."""
+
+START_FROM_REQUIRED_KEYS = ("steps",)
+START_FROM_DEFAULTS: dict[str, Any] = {
+    "decision": None,
+    "epochs": 10,
+    "pinned_probability": None,
+    "candidates": None,
+    "selection_cache": None,
+}
+"""The keys of a config's ``start_from`` block besides ``steps``, with their defaults."""
+
+
+@dataclasses.dataclass(frozen=True)
+class StartFrom:
+    """A config's ``start_from`` block: the fixed behaviour cloned into the policy before
+    reinforcement (see the module docstring for each key). Each key is checked on its own by
+    :func:`start_from_block`, and against the config's decision set by :meth:`require_fits`."""
+
+    decision: str | None
+    steps: int
+    epochs: int
+    pinned_probability: float | None
+    candidates: list[str] | None
+    selection_cache: str | None
+
+    @property
+    def selects(self) -> bool:
+        """Whether the run chooses its decision (``decision: best``,
+        :func:`agents.train.decision_selection.select_decision`)."""
+        return self.decision == BEST_DECISION
+
+    def require_fits(self, decisions: DecisionSet | None) -> None:
+        """``ValueError`` unless ``decision`` and ``candidates`` are decisions of
+        ``decisions``, the config's decision set (``None`` without ``decisions``, where the
+        paper trigger is cloned and there is no ``decision``)."""
+        if decisions is None:
+            if self.decision is not None:
+                raise ValueError(
+                    "config key 'start_from.decision' needs the key 'decisions' (without it the "
+                    "per-instant paper trigger is cloned)"
+                )
+            return
+        if self.decision is None:
+            raise ValueError(
+                "config key 'start_from.decision' is required with 'decisions': a decision "
+                f"label of the set or {BEST_DECISION!r}"
+            )
+        named = {"decision": [] if self.selects else [self.decision]}
+        named["candidates"] = self.candidates or []
+        for key, labels in named.items():
+            for label in labels:
+                try:
+                    decisions.action(label)
+                except ValueError as error:
+                    raise ValueError(f"config key 'start_from.{key}': {error}") from None
+
+
+def start_from_block(value: Any) -> StartFrom | None:
+    """The config's ``start_from`` value checked key by key (``None`` for null): one
+    ``ValueError`` line naming ``start_from.<key>`` and what it allows."""
+    if value is None:
+        return None
+    block = _check_mapping("start_from", value)
+    require_key_set(block, START_FROM_REQUIRED_KEYS, START_FROM_DEFAULTS, "config 'start_from'")
+    values = {**START_FROM_DEFAULTS, **block}
+    decision = values["decision"]
+    if decision is not None and (not isinstance(decision, str) or not decision):
+        raise ValueError(
+            "config key 'start_from.decision' must be a decision label or "
+            f"{BEST_DECISION!r}, got {decision!r}"
+        )
+    for key in ("candidates", "selection_cache"):
+        if values[key] is not None and decision != BEST_DECISION:
+            raise ValueError(
+                f"config key 'start_from.{key}' needs 'start_from.decision: {BEST_DECISION}', "
+                f"got decision={decision!r}"
+            )
+    if values["pinned_probability"] is not None and decision is None:
+        raise ValueError("config key 'start_from.pinned_probability' needs 'start_from.decision'")
+    return StartFrom(
+        decision=decision,
+        steps=_check_positive_int("start_from.steps", values["steps"]),
+        epochs=_check_positive_int("start_from.epochs", values["epochs"]),
+        pinned_probability=_check_probability(
+            "start_from.pinned_probability", values["pinned_probability"]
+        ),
+        candidates=_check_candidates(values["candidates"]),
+        selection_cache=_check_selection_cache(values["selection_cache"]),
+    )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -172,12 +260,7 @@ class TrainConfig:
     tensorboard: bool
     torch_threads: int
     init_from: str | None
-    imitation_steps: int
-    imitation_epochs: int
-    imitation_decision: str | None
-    imitation_candidates: list[str] | None
-    imitation_selection_cache: str | None
-    imitation_pinned_probability: float | None
+    start_from: StartFrom | None
     decisions: dict[str, Any] | None
 
     @property
@@ -203,10 +286,11 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     """Validate a config mapping and fill in the optional keys' defaults."""
     _check_key_set(raw)
     values = {**OPTIONAL_DEFAULTS, **raw}
-    if values["init_from"] is not None and values["imitation_steps"]:
+    start_from = start_from_block(values["start_from"])
+    if values["init_from"] is not None and start_from is not None:
         raise ValueError(
-            "config keys 'init_from' and 'imitation_steps' exclude each other: a run starts "
-            "from an earlier model or from the cloned paper trigger, not both"
+            "config keys 'init_from' and 'start_from' exclude each other: a run starts "
+            "from an earlier model or from a cloned decision, not both"
         )
     algorithm = _check_algorithm(values["algorithm"])
     seed = _check_seed(values["seed"])
@@ -215,7 +299,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         require_training_seeds(seed, n_envs, "config key 'seed'")
     env_id = _check_env_id(values["env_id"])
     env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
-    decisions = _check_decisions(values, algorithm, env_id, env_kwargs)
+    decisions = _check_decisions(values, algorithm, env_id, env_kwargs, start_from)
     _check_algorithm_fits_env(algorithm, env_id, env_kwargs, decisions)
     return TrainConfig(
         env_id=env_id,
@@ -243,12 +327,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         tensorboard=_check_tensorboard(values["tensorboard"]),
         torch_threads=_check_positive_int("torch_threads", values["torch_threads"]),
         init_from=_check_init_from(values["init_from"], env_id, env_kwargs, decisions),
-        imitation_steps=_check_non_negative_int("imitation_steps", values["imitation_steps"]),
-        imitation_epochs=_check_positive_int("imitation_epochs", values["imitation_epochs"]),
-        imitation_decision=values["imitation_decision"],
-        imitation_candidates=values["imitation_candidates"],
-        imitation_selection_cache=_check_selection_cache(values),
-        imitation_pinned_probability=_check_pinned_probability(values),
+        start_from=start_from,
         decisions=decisions,
     )
 
@@ -289,10 +368,8 @@ def _check_algorithm(name: Any) -> str:
     return name
 
 
-def _check_pinned_probability(values: Mapping[str, Any]) -> float | None:
-    """``values["imitation_pinned_probability"]``: null, or p in (0, 1) beside an imitation
-    decision."""
-    probability = values["imitation_pinned_probability"]
+def _check_probability(key: str, probability: Any) -> float | None:
+    """``probability``: null, or a number in (0, 1)."""
     if probability is None:
         return None
     if (
@@ -301,35 +378,53 @@ def _check_pinned_probability(values: Mapping[str, Any]) -> float | None:
         or not 0.0 < probability < 1.0
     ):
         raise ValueError(
-            "config key 'imitation_pinned_probability' must be a number in (0, 1) or null, "
-            f"got {probability!r}"
-        )
-    if values["imitation_decision"] is None:
-        raise ValueError(
-            "config key 'imitation_pinned_probability' needs the key 'imitation_decision'"
+            f"config key {key!r} must be a number in (0, 1) or null, got {probability!r}"
         )
     return float(probability)
 
 
+def _check_candidates(candidates: Any) -> list[str] | None:
+    """``start_from.candidates``: null, or a non-empty list of labels."""
+    if candidates is None:
+        return None
+    if (
+        not isinstance(candidates, list)
+        or not candidates
+        or not all(isinstance(label, str) for label in candidates)
+    ):
+        raise ValueError(
+            "config key 'start_from.candidates' must be a non-empty list of decision labels "
+            f"or null, got {candidates!r}"
+        )
+    return list(candidates)
+
+
+def _check_selection_cache(folder: Any) -> str | None:
+    """``start_from.selection_cache``: null, or a folder path."""
+    if folder is not None and (not isinstance(folder, str) or not folder):
+        raise ValueError(
+            f"config key 'start_from.selection_cache' must be a folder path or null, got {folder!r}"
+        )
+    return folder
+
+
 def _check_decisions(
-    values: Mapping[str, Any], algorithm: str, env_id: str, env_kwargs: dict[str, Any]
+    values: Mapping[str, Any],
+    algorithm: str,
+    env_id: str,
+    env_kwargs: dict[str, Any],
+    start_from: StartFrom | None,
 ) -> dict[str, Any] | None:
     """``values["decisions"]`` if it is null or keywords that build a
-    :class:`~agents.train.decisions.SelfTriggeredWrapper` for ``env_id``."""
-    label = values["imitation_decision"]
+    :class:`~agents.train.decisions.SelfTriggeredWrapper` for ``env_id``, which
+    ``start_from`` fits (:meth:`StartFrom.require_fits`)."""
     if values["decisions"] is None:
         if algorithm == "MaskablePPO":
             raise ValueError("config key 'algorithm': MaskablePPO needs the key 'decisions'")
-        if label is not None:
-            raise ValueError("config key 'imitation_decision' needs the key 'decisions'")
+        if start_from is not None:
+            start_from.require_fits(None)
         return None
     decisions = _check_mapping("decisions", values["decisions"])
-    if bool(values["imitation_steps"]) != (label is not None):
-        raise ValueError(
-            "config keys 'imitation_steps' and 'imitation_decision' go together with "
-            "'decisions' (the decision to clone, and for how many decisions), got "
-            f"imitation_steps={values['imitation_steps']!r}, imitation_decision={label!r}"
-        )
     allowed = (
         "max_exponent",
         "factors",
@@ -350,56 +445,11 @@ def _check_decisions(
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
     try:
-        _check_labels(values, wrapper.decisions)
+        if start_from is not None:
+            start_from.require_fits(wrapper.decisions)
     finally:
         wrapper.close()
     return decisions
-
-
-def _check_selection_cache(values: Mapping[str, Any]) -> str | None:
-    """``values["imitation_selection_cache"]``: null, or a folder path beside
-    ``imitation_decision: best``."""
-    folder = values["imitation_selection_cache"]
-    if folder is None:
-        return None
-    if values["imitation_decision"] != BEST_DECISION:
-        raise ValueError(
-            f"config key 'imitation_selection_cache' needs 'imitation_decision: {BEST_DECISION}'"
-        )
-    if not isinstance(folder, str) or not folder:
-        raise ValueError(
-            f"config key 'imitation_selection_cache' must be a folder path or null, got {folder!r}"
-        )
-    return folder
-
-
-def _check_labels(values: Mapping[str, Any], decisions: DecisionSet) -> None:
-    """``imitation_decision`` (a label of ``decisions`` or ``best``) and
-    ``imitation_candidates`` (null, or labels of ``decisions`` beside ``best``)."""
-    label, candidates = values["imitation_decision"], values["imitation_candidates"]
-    if candidates is not None and label != BEST_DECISION:
-        raise ValueError(
-            f"config key 'imitation_candidates' needs 'imitation_decision: {BEST_DECISION}', "
-            f"got imitation_decision={label!r}"
-        )
-    if label is None or label == BEST_DECISION:
-        if candidates is None:
-            return
-        if not isinstance(candidates, list) or not candidates:
-            raise ValueError(
-                "config key 'imitation_candidates' must be a non-empty list of decision labels "
-                f"or null, got {candidates!r}"
-            )
-        for candidate in candidates:
-            try:
-                decisions.action(str(candidate))
-            except ValueError as error:
-                raise ValueError(f"config key 'imitation_candidates': {error}") from None
-        return
-    try:
-        decisions.action(label)
-    except ValueError as error:
-        raise ValueError(f"config key 'imitation_decision': {error}") from None
 
 
 def _check_algorithm_fits_env(

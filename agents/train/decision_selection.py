@@ -8,7 +8,7 @@ episode is ``-Σ cost / cost_scale - λ · transmissions``, so a larger λ favou
 baseline. :func:`select_decision` runs each candidate decision, always taken, on the
 protocol's **validation** scenarios (never the test set) with the training env's keywords,
 λ among them, and picks the one whose mean return is highest: the best member of the policy
-class's fixed decisions at that λ. A front trained from a sweep of λ (``imitation_decision:
+class's fixed decisions at that λ. A front trained from a sweep of λ (``start_from.decision:
 best``, :mod:`agents.train.config`) then starts each λ from its own baseline instead of one label
 shared by every λ, so its points move along the transmission axis with λ.
 
@@ -46,7 +46,7 @@ from etsc_envs.core.files import atomic_write_text
 from etsc_envs.protocol import scenario_set
 
 BEST_DECISION = "best"
-"""The ``imitation_decision`` that asks :func:`select_decision` to choose per config."""
+"""The ``start_from.decision`` that asks :func:`select_decision` to choose per config."""
 
 
 def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str, Any]] | None:
@@ -113,7 +113,7 @@ def select_decision(
     Ties go to the earlier candidate. Returns ``{"chosen": label, "transmission_penalty": λ,
     "scenarios": the set described, "candidates": {label: set summary at λ}}`` (each summary
     :func:`agents.train.validation_callback.set_summary`'s); ``ValueError`` naming
-    ``imitation_candidates`` for a label the set lacks.
+    ``start_from.candidates`` for a label the set lacks.
     """
     labels = (
         [decisions.label(action) for action in range(decisions.action_space.n)]
@@ -121,11 +121,11 @@ def select_decision(
         else list(candidates)
     )
     if not labels:
-        raise ValueError("imitation_candidates: name at least one decision")
+        raise ValueError("start_from.candidates: name at least one decision")
     try:
         actions = [decisions.action(label) for label in labels]
     except ValueError as error:
-        raise ValueError(f"imitation_candidates: {error}") from None
+        raise ValueError(f"start_from.candidates: {error}") from None
     scenarios = scenario_set("validation", set_size)
     base = {key: value for key, value in env_kwargs.items() if key != "randomize"}
     penalty = transmission_penalty(env_id, scenarios.env_kwargs(base))

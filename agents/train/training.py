@@ -11,7 +11,7 @@ Writes to the output directory ``model.zip`` (a plain SB3 save, loadable by
 config after the command-line overrides and defaults), ``train_summary.json`` (wall time,
 timesteps, steps per second and the last episodes' returns and metrics), and as configured
 ``checkpoints/``, ``tensorboard/`` and ``evaluations.json`` (the policy against the paper's
-trigger during training), and with ``imitation_decision: best`` ``decision_selection.json``
+trigger during training), and with ``start_from.decision: best`` ``decision_selection.json``
 (every candidate decision's validation summary and the one chosen,
 :mod:`agents.train.decision_selection`). ``--resume`` continues from the newest intact checkpoint in
 ``checkpoints/`` up to ``total_timesteps``, keeping the evaluation history up to that
@@ -59,8 +59,8 @@ from stable_baselines3.common.on_policy_algorithm import OnPolicyAlgorithm
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 
 import etsc_envs
-from agents.train.config import TrainConfig, load_config
-from agents.train.decision_selection import BEST_DECISION, select_decision
+from agents.train.config import StartFrom, TrainConfig, load_config
+from agents.train.decision_selection import select_decision
 from agents.train.decisions import make_decision_env
 from agents.train.elapsed_discount import (
     ElapsedRolloutBuffer,
@@ -250,34 +250,33 @@ def _train(
     callbacks: Sequence[BaseCallback],
 ) -> Path:
     written = config
-    if config.imitation_decision == BEST_DECISION:
-        chosen = _selected_decision(config, out_dir, fresh=checkpoint is None)
-        config = dataclasses.replace(config, imitation_decision=chosen)
+    if config.start_from is not None and config.start_from.selects:
+        chosen = _selected_decision(config, config.start_from, out_dir, fresh=checkpoint is None)
+        config = dataclasses.replace(
+            config, start_from=dataclasses.replace(config.start_from, decision=chosen)
+        )
     env = _checked(
         "env_kwargs", make_training_env, config, checkpoint, exceptions=(TypeError, ValueError)
     )
     model = _build_model(config, env, checkpoint, out_dir)
     decisions = decision_set(config, env)
     imitation: dict[str, Any] | None = None
+    start_from = config.start_from
     if checkpoint is None:
         if config.checkpoint_every:
             _write_config(written, out_dir / CHECKPOINT_DIR / RUN_FILE)
-        if config.imitation_steps and decisions is not None:
+        if start_from is not None and decisions is not None:
             imitation = imitate_decision(
                 model,
                 decisions,
-                str(config.imitation_decision),
-                config.imitation_steps,
-                config.imitation_epochs,
-                pinned_probability=config.imitation_pinned_probability,
+                str(start_from.decision),
+                start_from.steps,
+                start_from.epochs,
+                pinned_probability=start_from.pinned_probability,
             )
-        elif config.imitation_steps:
+        elif start_from is not None:
             imitation = imitate_paper_trigger(
-                model,
-                config.env_id,
-                config.env_kwargs,
-                config.imitation_steps,
-                config.imitation_epochs,
+                model, config.env_id, config.env_kwargs, start_from.steps, start_from.epochs
             )
     if decisions is not None and config.env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env.env_method("follow_model", model)  # parameter sharing: teammates act as the model
@@ -315,8 +314,10 @@ def _train(
     return out_dir
 
 
-def _selected_decision(config: TrainConfig, out_dir: Path, fresh: bool) -> str:
-    """The decision an ``imitation_decision: best`` run starts from: chosen on the validation
+def _selected_decision(
+    config: TrainConfig, start_from: StartFrom, out_dir: Path, fresh: bool
+) -> str:
+    """The decision a ``start_from.decision: best`` run starts from: chosen on the validation
     scenarios at the run's env kwargs (:func:`~agents.train.decision_selection.select_decision`) and
     recorded in ``out_dir/decision_selection.json`` on a fresh run, read back from there on a
     resume."""
@@ -336,12 +337,12 @@ def _selected_decision(config: TrainConfig, out_dir: Path, fresh: bool) -> str:
         {**config.env_kwargs, **config.evaluation_env_kwargs},
         decisions,
         config.evaluation_scenarios,
-        config.imitation_candidates,
-        config.imitation_selection_cache,
+        start_from.candidates,
+        start_from.selection_cache,
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     atomic_write_text(path, json.dumps(selection, indent=2) + "\n")
-    print(f"imitation_decision: best at these env kwargs is {selection['chosen']!r}", flush=True)
+    print(f"start_from.decision: best at these env kwargs is {selection['chosen']!r}", flush=True)
     return str(selection["chosen"])
 
 
@@ -400,13 +401,13 @@ def _discounts_elapsed_instants(config: TrainConfig) -> bool:
 def training_decision_env(config: TrainConfig) -> gym.Env:
     """One env of ``config.env_id`` taking ``config.decisions``, discounting within an interval
     by the algorithm's ``gamma`` (for a PettingZoo id, one agent's decisions, its teammates
-    taking ``imitation_decision`` until they follow the model)."""
+    taking ``start_from.decision`` until they follow the model)."""
     return make_decision_env(
         config.env_id,
         config.env_kwargs,
         config.decisions,
         gamma=config.hyperparameters.get("gamma", 0.99),
-        teammate_decision=config.imitation_decision,
+        teammate_decision=None if config.start_from is None else config.start_from.decision,
     )
 
 
@@ -601,7 +602,7 @@ def _periodic_callbacks(
             config.evaluation_scenarios,
             out_dir / BEST_MODEL_FILE,
             decisions,
-            evaluate_at_start=bool(config.imitation_steps or config.init_from),
+            evaluate_at_start=config.start_from is not None or config.init_from is not None,
         )
         if checkpoint is not None:
             evaluation.restore(_previous_evaluations(out_dir, checkpoint))
