@@ -19,14 +19,10 @@ from baselines.self_triggered import decision_set_path, load_self_triggered
 from etsc_envs.core.compiled_loop import always_accepts
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
+from etsc_envs.core.paper import RULE_NAMES
 from etsc_envs.core.validation import require_int_at_least
-from etsc_envs.triggers import (
-    PAPER_TRIGGERS,
-    RULE_FAMILIES,
-    AlwaysPolicy,
-    PeriodicPolicy,
-    SwitchedPeriodicPolicy,
-)
+from etsc_envs.papers import ids_with_rule, paper_of, rule_of
+from etsc_envs.triggers import AlwaysPolicy, PeriodicPolicy, SwitchedPeriodicPolicy
 from etsc_envs.triggers.base import (
     ClockTrigger,
     HeartbeatPolicy,
@@ -89,8 +85,8 @@ def check_policy_arguments(spec: str, policy_args: dict[str, Any], env_id: str) 
         raise ValueError("--policy sb3: needs the path of a model zip, e.g. sb3:models/NAME.zip")
     counts = {"every", "then_every", "switch_after"} if spec == "periodic" else set()
     numbers: set[str] = set()
-    if spec in RULE_FAMILIES and env_id in RULE_FAMILIES[spec][0]:
-        trigger_class = RULE_FAMILIES[spec][0][env_id]
+    if spec in RULE_NAMES and env_id in ids_with_rule(spec):
+        trigger_class = rule_of(env_id, spec).trigger
         parameters = list(inspect.signature(trigger_class.__init__).parameters)
         numbers = set(parameters[4:])  # after self, the two spaces and the observation names
         counts = {"heartbeat", "floor", "channel_heartbeat"}
@@ -262,10 +258,9 @@ def _policy_for(
             sampling_period_s=environment.sampling_period_s,
             **policy_args,
         )
-    if spec in RULE_FAMILIES:
-        triggers = RULE_FAMILIES[spec][0]
-        if env_id not in triggers:
-            raise ValueError(f"no {spec} trigger for {env_id}; known: {sorted(triggers)}")
+    if spec in RULE_NAMES:
+        if env_id not in ids_with_rule(spec):
+            raise ValueError(f"no {spec} trigger for {env_id}; known: {ids_with_rule(spec)}")
         names = observation_names()
         arguments = dict(policy_args)
         heartbeat = arguments.pop("heartbeat", None)
@@ -285,14 +280,14 @@ def _policy_for(
             )
             for name, instants in (("floor", floor), ("channel_heartbeat", channel_heartbeat))
         )
-        trigger_class, bound = timed_rule_class(triggers[env_id], floor_s, heartbeat_s)
+        trigger_class, bound = timed_rule_class(rule_of(env_id, spec).trigger, floor_s, heartbeat_s)
         trigger = trigger_class(observation_space, action_space, names, **{**arguments, **bound})
         return trigger if heartbeat is None else HeartbeatPolicy(trigger, heartbeat)
     if spec.startswith("learned:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by learned triggers, got {policy_args}")
         learned = LearnedTrigger.load(spec.removeprefix("learned:"))
-        expected = PAPER_TRIGGERS[env_id].__name__
+        expected = paper_of(env_id).trigger.__name__
         if learned.family != expected:
             raise ValueError(
                 f"--policy {spec}: a trigger of the family {learned.family!r} (learned on "

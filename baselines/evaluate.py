@@ -10,7 +10,7 @@ heartbeat, a transmission on every channel once H instants passed without one, a
 since its last transmission; with both, as always taking the self-triggered decision
 "paper × f, floor F" whose interval cap is H), ``error_time``
 (paper 004's error-time rule, ``--policy-arg area=A`` in m·s,
-:data:`etsc_envs.triggers.ERROR_TIME_TRIGGERS`; ``heartbeat=H`` pairs it too), ``periodic``
+:attr:`etsc_envs.core.paper.Paper.error_time`; ``heartbeat=H`` pairs it too), ``periodic``
 (``--policy-arg every=K``; with ``then_every=K2`` and ``switch_after=N`` the period becomes
 K2 at instant N), ``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3
 model). ``--scenarios`` runs a fixed scenario set of the test protocol (docs/protocol.md);

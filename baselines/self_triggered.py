@@ -5,13 +5,13 @@ An action of :class:`DecisionSet` is one of
 * **hold 2^j** (j = 0 .. k): transmit every channel at the decision instant, hold the next
   2^j - 1 instants; the next decision comes 2^j instants later. Always choosing it is
   ``periodic every=2^j``.
-* **paper × f**: the paper's trigger with its threshold keywords
-  (:data:`etsc_envs.triggers.PAPER_THRESHOLDS`) scaled by f decides every instant, the
+* **paper × f**: the paper's trigger with its threshold keywords (its paper record's
+  :attr:`~etsc_envs.core.paper.Paper.rule`) scaled by f decides every instant, the
   decision instant included; the interval ends just before a later instant at which it fires
   (on any channel), after 2^k instants (or the set's ``rule_cap``, which may give each factor
   its own), or with the episode.
   Always choosing f = 1 is the paper's trigger. A set whose ``rule`` is ``error_time`` offers
-  the id's error-time rule (:data:`etsc_envs.triggers.ERROR_TIME_TRIGGERS`) the same way,
+  the id's error-time rule (:attr:`~etsc_envs.core.paper.Paper.error_time`) the same way,
   labelled **error_time × f**.
 * **paper × f, heartbeat H** (a set with ``rule_heartbeat``, H its ``rule_cap``, or the factor's
   own cap where ``rule_cap`` is a list): as paper × f,
@@ -39,7 +39,7 @@ sends every channel, the paper's rule sends the channels it names. :class:`Inter
 runs these semantics one instant at a time for a batch of rows; the training wrapper
 (:class:`agents.train.decisions.SelfTriggeredWrapper`) and the deployed transmit/hold policy
 (:class:`SelfTriggeredPolicy`) both drive it, so they take the same decisions. Where the id has
-a shield (:data:`etsc_envs.triggers.PAPER_SHIELDS`) and a ``shield_multiple`` is set, unsafe
+a shield (:attr:`~etsc_envs.core.paper.Paper.shield`) and a ``shield_multiple`` is set, unsafe
 actions are masked (:meth:`IntervalSchedule.masks`) and an unsafe choice is replaced by the
 longest safe action of its kind below it, or by hold 1, which is always safe.
 
@@ -64,7 +64,8 @@ import numpy as np
 from baselines.policies import load_sb3, takes_action_masks
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
-from etsc_envs.triggers import PAPER_SHIELDS, PAPER_TRIGGERS, RULE_FAMILIES
+from etsc_envs.core.paper import RULE_NAMES
+from etsc_envs.papers import PAPER_IDS, ids_with_rule, paper_of, rule_of
 from etsc_envs.triggers.base import (
     batched_observations,
     instants_seconds,
@@ -75,23 +76,8 @@ from etsc_envs.triggers.base import (
 DEFAULT_MAX_EXPONENT = 10
 """Longest hold 2^10 = 1024 sampling instants."""
 
-DEFAULT_FACTORS = (0.5, 1.0, 2.0, 4.0)
-"""Scalings of the paper's threshold offered as actions."""
-
-DEFAULT_FACTORS_BY_ID = {
-    # eq. (15) needs 0 < c < 1 (c = 0.6 in the paper): c = 0.15 .. 0.9.
-    "etsc/ClusterContainmentCentral-v0": (0.25, 0.5, 1.0, 1.5),
-    "etsc/ClusterContainment-v0": (0.25, 0.5, 1.0, 1.5),
-}
-"""Ids whose threshold does not admit every factor of :data:`DEFAULT_FACTORS`."""
-
 DECISIONS_SUFFIX = "_decisions.json"
 """A self-triggered model ``NAME.zip`` keeps its decision set in ``NAME_decisions.json``."""
-
-
-def default_factors(env_id: str) -> tuple[float, ...]:
-    """The threshold factors offered for ``env_id`` by default."""
-    return DEFAULT_FACTORS_BY_ID.get(env_id, DEFAULT_FACTORS)
 
 
 def decision_set_path(model_path: str | Path) -> Path:
@@ -108,7 +94,7 @@ class DecisionSet:
         env_id: the transmit/hold id the decisions act in.
         max_exponent: k, the longest hold is 2^k sampling instants (an integer >= 0).
         factors: the scalings f > 0 of the paper's threshold, one action each (``None``: the
-            id's default, :func:`default_factors`).
+            id's default, its paper record's :attr:`~etsc_envs.core.paper.Paper.factors`).
         shield_multiple: the shield's bound (for 004, sampling errors within this many Π), or
             ``None`` for no shield.
         sampling_period_s: the env's sampling period (s), which the shield converts holds
@@ -122,7 +108,7 @@ class DecisionSet:
         rule_floor: the floor F of "paper × f, floor F" actions (an integer in 1..2^20, at most
             ``rule_cap``; needs ``sampling_period_s``), a list of one such floor per factor
             (the rule actions then pair each factor with its own floor), or ``None`` for none.
-        rule: the family of the rule actions (:data:`etsc_envs.triggers.RULE_FAMILIES`):
+        rule: the family of the rule actions (:data:`etsc_envs.core.paper.RULE_NAMES`):
             ``paper`` (the paper's trigger) or ``error_time`` (the id's error-time rule, which
             the shield does not cover); it names them (``paper x2``, ``error_time x2``).
         rule_keywords: further keyword arguments of the rule's trigger, the same for every
@@ -149,14 +135,14 @@ class DecisionSet:
     holds: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
-        if self.env_id not in PAPER_TRIGGERS:
+        if self.env_id not in PAPER_IDS:
             raise ValueError(f"env_id: no paper trigger for {self.env_id!r}")
         exponent = self.max_exponent
         if isinstance(exponent, bool) or not isinstance(exponent, int) or not 0 <= exponent <= 20:
             raise ValueError(f"max_exponent must be an integer in 0..20, got {exponent!r}")
         if self.holds is not None:
             object.__setattr__(self, "holds", checked_holds(self.holds))
-        given = default_factors(self.env_id) if self.factors is None else self.factors
+        given = paper_of(self.env_id).factors if self.factors is None else self.factors
         factors = tuple(float(f) for f in given)
         if not all(np.isfinite(f) and f > 0.0 for f in factors):
             raise ValueError(f"factors must be finite numbers > 0, got {self.factors!r}")
@@ -208,12 +194,12 @@ class DecisionSet:
                 )
             if self.sampling_period_s is None:
                 raise ValueError("sampling_period_s must be given with rule_channel_heartbeat")
-        if self.rule not in RULE_FAMILIES:
-            raise ValueError(f"rule must be one of {sorted(RULE_FAMILIES)}, got {self.rule!r}")
-        if self.env_id not in RULE_FAMILIES[self.rule][0]:
+        if self.rule not in RULE_NAMES:
+            raise ValueError(f"rule must be one of {sorted(RULE_NAMES)}, got {self.rule!r}")
+        if self.rule not in paper_of(self.env_id).rules:
             raise ValueError(
                 f"rule: no {self.rule} rule for {self.env_id}; it exists for "
-                f"{sorted(RULE_FAMILIES[self.rule][0])}"
+                f"{ids_with_rule(self.rule)}"
             )
         if self.rule_keywords is not None:
             checked = checked_rule_keywords(self.env_id, self.rule, self.rule_keywords)
@@ -226,10 +212,10 @@ class DecisionSet:
                 f"holds or another rule; a set with rule {self.rule!r} and rule_floor "
                 f"{self.rule_floor!r} must have shield_multiple null"
             )
-        if self.env_id not in PAPER_SHIELDS:
+        if paper_of(self.env_id).shield is None:
+            shielded = [env_id for env_id in PAPER_IDS if paper_of(env_id).shield is not None]
             raise ValueError(
-                f"shield_multiple: no shield for {self.env_id}; shields exist for "
-                f"{sorted(PAPER_SHIELDS)}"
+                f"shield_multiple: no shield for {self.env_id}; shields exist for {shielded}"
             )
         if self.sampling_period_s is None:
             raise ValueError("sampling_period_s must be given with shield_multiple")
@@ -358,8 +344,8 @@ def checked_rule_keywords(env_id: str, rule: str, keywords: Any) -> dict[str, fl
     takes besides its scaled thresholds (:func:`scaled_thresholds`); ``ValueError`` naming
     ``rule_keywords`` and the allowed names otherwise. The values' ranges are the trigger's to
     check when it is built."""
-    scaled = set(RULE_FAMILIES[rule][1][env_id]())
-    parameters = inspect.signature(RULE_FAMILIES[rule][0][env_id]).parameters
+    scaled = set(rule_of(env_id, rule).thresholds())
+    parameters = inspect.signature(rule_of(env_id, rule).trigger).parameters
     allowed = sorted(
         name
         for name, parameter in parameters.items()
@@ -388,8 +374,8 @@ def checked_rule_keywords(env_id: str, rule: str, keywords: Any) -> dict[str, fl
 
 def scaled_thresholds(env_id: str, factor: float, rule: str = "paper") -> dict[str, float]:
     """The threshold keywords of ``env_id``'s ``rule`` trigger
-    (:data:`~etsc_envs.triggers.RULE_FAMILIES`) at ``factor`` times their default values."""
-    thresholds = RULE_FAMILIES[rule][1][env_id]()
+    (:func:`~etsc_envs.papers.rule_of`) at ``factor`` times their default values."""
+    thresholds = rule_of(env_id, rule).thresholds()
     return {name: factor * value for name, value in thresholds.items()}
 
 
@@ -416,14 +402,14 @@ def scaled_rule_trigger(
     heartbeat_s: float | None = None,
     rule_keywords: Mapping[str, float] | None = None,
 ) -> Any:
-    """The ``rule`` trigger of ``env_id`` (:data:`~etsc_envs.triggers.RULE_FAMILIES`) with its
+    """The ``rule`` trigger of ``env_id`` (:func:`~etsc_envs.papers.rule_of`) with its
     threshold keywords scaled by ``factor`` and ``rule_keywords`` (not scaled) added, with a
     floor of ``floor_s`` seconds (:func:`~etsc_envs.triggers.base.floored_trigger_class`) or a
     heartbeat per channel of ``heartbeat_s`` seconds
     (:func:`~etsc_envs.triggers.base.channel_heartbeat_trigger_class`) if given (not both);
     ``ValueError`` naming ``factors`` (and ``rule_keywords`` where given) when the values leave
     the trigger's range."""
-    trigger_class, bound = timed_rule_class(RULE_FAMILIES[rule][0][env_id], floor_s, heartbeat_s)
+    trigger_class, bound = timed_rule_class(rule_of(env_id, rule).trigger, floor_s, heartbeat_s)
     keywords = {**rule_arguments(env_id, factor, rule, rule_keywords), **bound}
     try:
         return trigger_class(observation_space, action_space, observation_names, **keywords)
@@ -474,12 +460,11 @@ class IntervalSchedule:
                 decisions.factors, decisions.floors, decisions.channel_heartbeats, strict=True
             )
         ]
+        shield = paper_of(decisions.env_id).shield
         self.shield = (
             None
-            if decisions.shield_multiple is None
-            else PAPER_SHIELDS[decisions.env_id](
-                observation_names, decisions.sampling_period_s, decisions.shield_multiple
-            )
+            if decisions.shield_multiple is None or shield is None
+            else shield(observation_names, decisions.sampling_period_s, decisions.shield_multiple)
         )
 
     def masks(self, obs: np.ndarray) -> np.ndarray:

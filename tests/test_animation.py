@@ -13,7 +13,7 @@ import pytest
 from PIL import Image
 
 from etsc_envs.animation import FINAL_HOLD_S, frame_steps, gym_frames, write_gif
-from etsc_envs.triggers import PAPER_TRIGGERS
+from etsc_envs.papers import paper_of
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 
@@ -41,7 +41,7 @@ class Stepwise:
 def test_the_compiled_rule_draws_the_frames_of_its_steps(tmp_path):
     def frames(policy_of):
         env = gym.make(ENV_ID, render_mode="rgb_array", horizon_s=0.3).unwrapped
-        rule = PAPER_TRIGGERS[ENV_ID](
+        rule = paper_of(ENV_ID).trigger(
             env.observation_space, env.action_space, observation_names=env.observation_names
         )
         return gym_frames(env, policy_of(rule), frames=3), env

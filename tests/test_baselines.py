@@ -39,8 +39,8 @@ from baselines.episodes import run_episode, to_jsonable
 from baselines.evaluate import evaluate
 from baselines.policies import infer_sb3_algorithm, load_sb3
 from baselines.reproductions.report import Scenario, claim, metric_row, render, stages
+from etsc_envs.papers import paper_of
 from etsc_envs.triggers import (
-    PAPER_TRIGGERS,
     AlwaysPolicy,
     AttitudeTrackingTrigger,
     PeriodicPolicy,
@@ -148,7 +148,7 @@ def test_paper_trigger_rejects_bad_psi(env, psi):
 
 
 def test_paper_trigger_is_registered_for_the_env():
-    assert PAPER_TRIGGERS[ENV_ID] is AttitudeTrackingTrigger
+    assert paper_of(ENV_ID).trigger is AttitudeTrackingTrigger
 
 
 # --------------------------------------------------------------------------- periodic
@@ -496,7 +496,7 @@ def test_a_heartbeat_bounds_every_channel_gap_and_keeps_the_rule(env_id, heartbe
         assert with_beat["transmissions"] > without["transmissions"]
     env = gym.make(env_id, **args)
     unwrapped = env.unwrapped
-    rule = PAPER_TRIGGERS[env_id](
+    rule = paper_of(env_id).trigger(
         env.observation_space, env.action_space, unwrapped.observation_names, **thresholds[env_id]
     )
     from etsc_envs.triggers.base import HeartbeatPolicy

@@ -67,7 +67,8 @@ from etsc_envs.core.integration import make_rk4_step
 from etsc_envs.core.jit import jit
 from etsc_envs.core.metrics import COMMON_EPISODE_KEYS
 from etsc_envs.core.rotations import quat_kinematics, quat_to_mrp
-from etsc_envs.triggers import PAPER_TRIGGERS, ClusterContainmentTrigger
+from etsc_envs.papers import paper_of
+from etsc_envs.triggers import ClusterContainmentTrigger
 
 PARALLEL_ID = "etsc/ClusterContainment-v0"
 CENTRAL_ID = "etsc/ClusterContainmentCentral-v0"
@@ -194,7 +195,8 @@ def test_ids_and_make_helpers():
     assert aec.agent_selection == "follower_0"
     with pytest.raises(ValueError, match="unknown PettingZoo id"):
         etsc_envs.make_parallel("etsc/NoSuchEnv-v0")
-    assert PAPER_TRIGGERS[PARALLEL_ID] is PAPER_TRIGGERS[CENTRAL_ID] is ClusterContainmentTrigger
+    assert paper_of(PARALLEL_ID) is paper_of(CENTRAL_ID)
+    assert paper_of(CENTRAL_ID).trigger is ClusterContainmentTrigger
 
 
 # --------------------------------------------------------------------------- reproducibility

@@ -10,7 +10,8 @@ import pytest
 
 import etsc_envs
 from etsc_envs.compile import kernel_tasks, main, rule_triggers
-from etsc_envs.triggers import ERROR_TIME_TRIGGERS, PAPER_TRIGGERS, ClockTrigger
+from etsc_envs.papers import paper_of
+from etsc_envs.triggers import ClockTrigger
 from etsc_envs.triggers.base import RuleTrigger
 
 
@@ -23,7 +24,7 @@ def test_the_kernel_list_covers_every_id():
     for env_id in etsc_envs.ENV_IDS:
         assert {"env step, holds and metrics", "vector env step", "paper rule"} <= pieces[env_id]
         assert "trigger family" in pieces[env_id]
-        assert ("error-time rule" in pieces[env_id]) == (env_id in ERROR_TIME_TRIGGERS)
+        assert ("error-time rule" in pieces[env_id]) == (paper_of(env_id).error_time is not None)
     for env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         assert pieces[env_id] == {"parallel env step"}
         assert etsc_envs.PETTINGZOO_LOOP_IDS[env_id] in pieces  # its loop's rules and vector env
@@ -38,8 +39,8 @@ def test_each_rule_listed_is_the_rule_the_suite_runs(env_id):
     built = {name: build(env) for name, build in rule_triggers(env_id).items()}
     env.close()
     assert all(isinstance(trigger, RuleTrigger) for trigger in built.values())
-    assert type(built["paper rule"]).rule is PAPER_TRIGGERS[env_id].rule
-    assert built["trigger family"].paper_class is PAPER_TRIGGERS[env_id]
+    assert type(built["paper rule"]).rule is paper_of(env_id).trigger.rule
+    assert built["trigger family"].paper_class is paper_of(env_id).trigger
     if "clock" in built:
         assert isinstance(built["clock"], ClockTrigger)
 

@@ -18,7 +18,8 @@ from baselines.episodes import run_episode
 from baselines.evaluate import evaluate
 from baselines.policies import load_sb3, takes_action_masks
 from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
-from etsc_envs.triggers import PAPER_THRESHOLDS, PAPER_TRIGGERS, PeriodicPolicy
+from etsc_envs.papers import paper_of
+from etsc_envs.triggers import PeriodicPolicy
 from etsc_envs.triggers.asteroid import AsteroidShield
 from etsc_envs.triggers.inner_formation import InnerFormationShield, default_error_time_thresholds
 
@@ -85,7 +86,7 @@ def policy_actions(env_id: str, policy) -> list[np.ndarray]:
 def paper_policy(env_id: str):
     env = gym.make(env_id, horizon_s=HORIZON_S)
     unwrapped = env.unwrapped
-    return PAPER_TRIGGERS[env_id](
+    return paper_of(env_id).trigger(
         env.observation_space, env.action_space, unwrapped.observation_names
     )
 
@@ -199,11 +200,11 @@ def test_the_heartbeat_action_is_the_rule_paired_with_a_heartbeat(env_id, factor
         info["elapsed_steps"] for info in infos
     ]
     env = gym.make(env_id, horizon_s=HORIZON_S)
-    rule = PAPER_TRIGGERS[env_id](
+    rule = paper_of(env_id).trigger(
         env.observation_space,
         env.action_space,
         env.unwrapped.observation_names,
-        **{name: factor * value for name, value in PAPER_THRESHOLDS[env_id]().items()},
+        **{name: factor * value for name, value in paper_of(env_id).rule.thresholds().items()},
     )
     paired = policy_actions(env_id, HeartbeatPolicy(rule, heartbeat))
     assert_same(actions, paired)
@@ -229,11 +230,13 @@ def test_a_heartbeat_per_factor_pairs_each_factor_with_its_own():
     ):
         follow = ScriptedModel(0, fixed=decisions.n_holds + index)
         actions, _ = wrapper_actions(ATTITUDE, follow, **kwargs, rule_heartbeat=True)
-        rule = PAPER_TRIGGERS[ATTITUDE](
+        rule = paper_of(ATTITUDE).trigger(
             env.observation_space,
             env.action_space,
             env.unwrapped.observation_names,
-            **{name: factor * value for name, value in PAPER_THRESHOLDS[ATTITUDE]().items()},
+            **{
+                name: factor * value for name, value in paper_of(ATTITUDE).rule.thresholds().items()
+            },
         )
         assert_same(actions, policy_actions(ATTITUDE, HeartbeatPolicy(rule, heartbeat)))
 
@@ -659,9 +662,9 @@ def test_the_decentralised_cluster_trains_pinned_and_deploys(tmp_path):
 
 
 def test_a_decision_set_takes_its_ids_default_factors():
-    from baselines.self_triggered import DEFAULT_FACTORS, default_factors
+    from etsc_envs.core.paper import DEFAULT_FACTORS
 
     cluster = "etsc/ClusterContainment-v0"
-    assert DecisionSet(cluster).factors == default_factors(cluster) != DEFAULT_FACTORS
+    assert DecisionSet(cluster).factors == paper_of(cluster).factors != DEFAULT_FACTORS
     assert DecisionSet(ATTITUDE).factors == DEFAULT_FACTORS
     assert DecisionSet(ATTITUDE, factors=[2, 8]).factors == (2.0, 8.0)

@@ -13,7 +13,7 @@ from agents.train.decisions import SelfTriggeredWrapper
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.self_triggered import DecisionSet
-from etsc_envs.triggers import ERROR_TIME_TRIGGERS, RULE_FAMILIES
+from etsc_envs.papers import rule_of
 from etsc_envs.triggers.inner_formation import (
     AXES,
     ERROR_TIME_REFERENCE_S,
@@ -90,7 +90,7 @@ def test_default_thresholds_are_the_paper_thresholds_times_the_reference_time():
     )
     env = formation_env(horizon_s=0.05)
     np.testing.assert_allclose(error_time_trigger(env).thresholds, default_error_time_thresholds())
-    assert RULE_FAMILIES["error_time"][0] is ERROR_TIME_TRIGGERS
+    assert rule_of(FORMATION, "error_time").trigger is InnerFormationErrorTimeTrigger
 
 
 def test_follow_the_error_time_rule_is_the_error_time_trigger():

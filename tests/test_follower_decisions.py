@@ -13,7 +13,7 @@ import etsc_envs
 from agents.train.follower_decisions import FollowerDecisionEnv
 from baselines.episodes import run_parallel_episode
 from baselines.self_triggered import SelfTriggeredPolicy
-from etsc_envs.triggers import PAPER_TRIGGERS
+from etsc_envs.papers import paper_of
 from etsc_envs.triggers.base import HeartbeatPolicy
 
 CLUSTER = "etsc/ClusterContainment-v0"
@@ -95,7 +95,7 @@ def rule_alone(horizon_s: float, seed: int, heartbeat: int | None = None, **thre
     with ``heartbeat``)."""
     parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=horizon_s)
     agent = parallel.possible_agents[0]
-    rule = PAPER_TRIGGERS[CLUSTER](
+    rule = paper_of(CLUSTER).trigger(
         parallel.observation_space(agent),
         parallel.action_space(agent),
         parallel.unwrapped.agent_observation_names,

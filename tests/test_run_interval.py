@@ -14,7 +14,8 @@ import pytest
 
 from baselines.self_triggered import scaled_rule_trigger
 from etsc_envs import ENV_IDS
-from etsc_envs.triggers import PAPER_TRIGGERS, PeriodicPolicy
+from etsc_envs.papers import paper_of
+from etsc_envs.triggers import PeriodicPolicy
 
 SEED = 5
 HORIZONS_S = {
@@ -208,7 +209,7 @@ def test_a_rule_interval_stops_at_a_failure_as_its_steps_do(env_id):
     kwargs, failure_step = FAILING[env_id]
     compiled, stepwise = pair(env_id, seed=0, **kwargs)
     if env_id == "etsc/ClusterContainmentCentral-v0":  # eq. (15) needs c < 1: raise rho
-        trigger = PAPER_TRIGGERS[env_id](
+        trigger = paper_of(env_id).trigger(
             compiled.observation_space,
             compiled.action_space,
             compiled.unwrapped.observation_names,

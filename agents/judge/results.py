@@ -57,6 +57,7 @@ from baselines.cli import (
 from baselines.evaluate import evaluate, positive_integer
 from baselines.statistics import paired_ratio, seeds_ratio
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
+from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import DEFAULT_SET_SIZE, PROTOCOL_VERSION, SCENARIO_SET_NAMES
 
 COST_RATIO_MAX = 1.05
@@ -67,16 +68,6 @@ TRANSMISSION_RATIO_MAX = 0.70
 
 MIN_CLAIM_SEEDS = 3
 """Training seeds a method's claim stands on, at least."""
-
-PAPER_KEYS = {
-    "etsc/AttitudeTracking-v0": ("mean_input_norm",),
-    "etsc/OrbitAttitudeTracking-v0": ("ss_att_err_deg", "ss_pos_err_m", "settle_pos_s"),
-    "etsc/ClusterContainmentCentral-v0": ("converge_time_s", "final_containment_err"),
-    "etsc/ClusterContainment-v0": ("converge_time_s", "final_containment_err"),
-    "etsc/AsteroidOrbitKeeping-v0": ("min_radius_m", "max_radius_m", "delta_v_mps"),
-    "etsc/InnerFormation-v0": ("ss_pos_err_m", "ss_pos_est_err_m"),
-}
-"""Id → the paper's own metrics shown beside ``mean_cost`` and the transmissions."""
 
 
 def channel_count(env_id: str, env_args: dict[str, Any]) -> int:
@@ -336,8 +327,10 @@ def _policy_row(name: str, result: dict[str, Any], keys: tuple[str, ...]) -> str
 
 
 def markdown(result: dict[str, Any]) -> str:
-    """The comparison as Markdown: one table per scenario set, then the verdicts."""
-    keys = PAPER_KEYS.get(result["env"], ())
+    """The comparison as Markdown: one table per scenario set (with the paper's headline
+    metrics, :attr:`~etsc_envs.core.paper.Paper.headline_metrics`), then the verdicts."""
+    env_id = result["env"]
+    keys = paper_of(env_id).headline_metrics if env_id in PAPER_IDS else ()
     lines = []
     for name, compared in result["sets"].items():
         size = compared["scenarios"]["size"]

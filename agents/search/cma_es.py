@@ -54,8 +54,8 @@ import yaml
 
 import etsc_envs
 from etsc_envs.core.files import atomic_write_text, output_folder_argument
+from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import require_training_seeds, scenario_set
-from etsc_envs.triggers import FAMILY_CLASSES, PAPER_TRIGGERS
 from etsc_envs.triggers.family import FamilyPoint, LearnedTrigger, Modulation
 
 TRAINING_SEED_BASE = 10_000_000
@@ -97,7 +97,7 @@ class SearchConfig:
 
     @property
     def family(self) -> type:
-        return PAPER_TRIGGERS[self.env_id]
+        return paper_of(self.env_id).trigger
 
     def env_args(self, *, training: bool) -> dict[str, Any]:
         """The env keywords of a training (shortened horizon) or a validation scenario."""
@@ -132,8 +132,8 @@ def config_from_dict(raw: dict[str, Any]) -> SearchConfig:
             f"search config: unknown keys {sorted(unknown)}; allowed {sorted(allowed)}"
         )
     env_id = raw.get("env_id")
-    if env_id not in PAPER_TRIGGERS or PAPER_TRIGGERS[env_id].__name__ not in FAMILY_CLASSES:
-        raise ValueError(f"env_id must be one of {sorted(PAPER_TRIGGERS)}, got {env_id!r}")
+    if env_id not in PAPER_IDS:
+        raise ValueError(f"env_id must be one of {list(PAPER_IDS)}, got {env_id!r}")
     search = tuple(raw.get("search", ()))
     if not search or set(search) - set(DIMENSIONS):
         raise ValueError(f"search must be a non-empty list of {DIMENSIONS}, got {list(search)}")

@@ -65,10 +65,10 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     Args:
         env: the transmit/hold env.
         max_exponent: the longest hold is 2^max_exponent instants.
-        factors: scalings of the paper's threshold offered as actions (default per id:
-            :func:`~baselines.self_triggered.default_factors`).
+        factors: scalings of the paper's threshold offered as actions (default per id: its
+            paper record's :attr:`~etsc_envs.core.paper.Paper.factors`).
         shield_multiple: the shield's bound, or ``None`` for no shield (ids with a shield:
-            :data:`etsc_envs.triggers.PAPER_SHIELDS`).
+            those whose record has a :attr:`~etsc_envs.core.paper.Paper.shield`).
         gamma: the per-instant discount within an interval (in (0, 1]); the algorithm's
             ``gamma`` when it discounts by elapsed instants.
         rule_cap: the longest "paper × f" interval in instants, or one per factor (a list;

@@ -2,19 +2,10 @@
 
 from __future__ import annotations
 
-from baselines.reproductions import (
-    asteroid,
-    attitude_tracking,
-    cluster,
-    inner_formation,
-    orbit_attitude,
-)
+import importlib
 
-REPRODUCTIONS = {
-    "000": orbit_attitude,
-    "001": cluster,
-    "002": attitude_tracking,
-    "003": asteroid,
-    "004": inner_formation,
-}
-"""Paper number → module with ``PAPER``, ``TITLE`` and ``reproduce(plot_dir, progress)``."""
+from etsc_envs.papers import PAPERS
+
+REPRODUCTIONS = {paper.number: importlib.import_module(paper.reproduction) for paper in PAPERS}
+"""Paper number → module with ``PAPER``, ``TITLE`` and ``reproduce(plot_dir, progress)`` (each
+paper record's :attr:`~etsc_envs.core.paper.Paper.reproduction`)."""

@@ -28,10 +28,11 @@ from baselines.reproductions.report import (
     run_scenarios,
     scenario_instants,
 )
+from etsc_envs.papers import paper_numbered
 from etsc_envs.triggers.asteroid import PAPER_ALPHA
 
 PAPER = "003"
-TITLE = "Barrier-based event-triggered orbit keeping near asteroid 25143 Itokawa"
+TITLE = paper_numbered(PAPER).title
 ENV_ID = "etsc/AsteroidOrbitKeeping-v0"
 SAMPLE_EVERY = 4  # steps between stored states for the figures (1 s)
 PAPER_BURSTS = 8

@@ -22,9 +22,10 @@ from baselines.reproductions.report import (
     run_scenarios,
     scenario_instants,
 )
+from etsc_envs.papers import paper_numbered
 
 PAPER = "002"
-TITLE = "Event-triggered attitude tracking for rigid spacecraft (Cai et al. 2019)"
+TITLE = paper_numbered(PAPER).title
 ENV_ID = "etsc/AttitudeTracking-v0"
 SAMPLE_EVERY = 20  # steps between stored states for the figures (20 ms)
 

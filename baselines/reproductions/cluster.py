@@ -31,9 +31,10 @@ from baselines.reproductions.report import (
 )
 from etsc_envs.cluster.env import hull_distance
 from etsc_envs.cluster.params import FIGURE_5_CELLS
+from etsc_envs.papers import paper_numbered
 
 PAPER = "001"
-TITLE = "Event-triggered adaptive sliding-mode attitude containment of a microsatellite cluster"
+TITLE = paper_numbered(PAPER).title
 ENV_ID = "etsc/ClusterContainment-v0"
 PAPER_HORIZON_S = 1200.0
 SAMPLE_EVERY = 100  # steps between stored states (1 s)

@@ -24,10 +24,11 @@ from baselines.reproductions.report import (
     run_scenarios,
     scenario_instants,
 )
+from etsc_envs.papers import paper_numbered
 from etsc_envs.triggers.inner_formation import AXES, default_thresholds
 
 PAPER = "004"
-TITLE = "Event-triggered disturbance estimation and output feedback, inner formation (Hao 2024)"
+TITLE = paper_numbered(PAPER).title
 ENV_ID = "etsc/InnerFormation-v0"
 SAMPLE_EVERY = 100  # steps between stored states for the figures (0.1 s)
 EARLY_WINDOW_S = 5.0

@@ -35,9 +35,10 @@ from baselines.reproductions.report import (
 )
 from etsc_envs.orbit_attitude.closed_loop import disturbance_step
 from etsc_envs.orbit_attitude.dynamics import thruster_outputs
+from etsc_envs.papers import paper_numbered
 
 PAPER = "000"
-TITLE = "ESO-based event-triggered orbit-attitude tracking for low-thrust spacecraft (Zhang 2019)"
+TITLE = paper_numbered(PAPER).title
 ENV_ID = "etsc/OrbitAttitudeTracking-v0"
 SAMPLE_EVERY = 20  # steps between stored states (20 ms)
 QUIET_WINDOW_S = (150.0, 155.0)  # the interval the paper magnifies in Figs. 9-11
