@@ -20,9 +20,9 @@ than the settled end. Each frame's title gives its time.
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
@@ -31,6 +31,7 @@ from PIL import Image
 import etsc_envs
 from etsc_envs.core.render import RENDER_FPS
 from etsc_envs.papers import paper_of
+from etsc_envs.triggers.base import RuleTrigger
 
 GIF_DIR = Path("docs/envs")
 """Where the command writes, relative to the working directory (the checkout's root)."""
@@ -149,7 +150,9 @@ def paper_gif(env_id: str, out_dir: str | Path, frames: int = FRAMES) -> Path:
     """The GIF of ``env_id`` under the paper's trigger (the scenario of :data:`SCENARIOS`, else
     the paper's), written to ``out_dir``/:func:`gif_name`."""
     kwargs = {"render_mode": "rgb_array", **SCENARIOS.get(env_id, {})}
-    trigger_class = paper_of(env_id).trigger
+    # Built with the paper trigger's own constructor arguments (spaces, observation names),
+    # which RuleTrigger's signature does not describe.
+    trigger_class = cast(Callable[..., RuleTrigger], paper_of(env_id).trigger)
     env: Any  # the suite's env class, which make_parallel and gym.make type as their bases
     if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env = etsc_envs.make_parallel(env_id, **kwargs)

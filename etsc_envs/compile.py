@@ -66,18 +66,18 @@ def rule_triggers(env_id: str) -> dict[str, RuleBuilder]:
     takes every transmission, as ``--policy periodic`` then runs the clock rule)."""
     record = paper_of(env_id)
     paper = record.trigger
-    builders: dict[str, RuleBuilder] = {"paper rule": lambda env: paper(*_spaces(env))}
+    builders: dict[str, RuleBuilder] = {"paper rule": lambda env: _rule(paper, env)}
     if record.error_time is not None:
         error_time = record.error_time.trigger
-        builders["error-time rule"] = lambda env: error_time(*_spaces(env))
+        builders["error-time rule"] = lambda env: _rule(error_time, env)
     if paper.condition is not None:
         family = family_trigger_class(paper)
-        builders["trigger family"] = lambda env: family(
-            *_spaces(env), point=FamilyPoint(), sampling_period_s=_loop(env).sampling_period_s
+        builders["trigger family"] = lambda env: _rule(
+            family, env, point=FamilyPoint(), sampling_period_s=_loop(env).sampling_period_s
         )
     if env_id not in etsc_envs.PETTINGZOO_ENV_IDS and _takes_every_transmission(env_id):
-        builders["clock"] = lambda env: ClockTrigger(
-            *_spaces(env), every=CLOCK_EVERY, sampling_period_s=_loop(env).sampling_period_s
+        builders["clock"] = lambda env: _rule(
+            ClockTrigger, env, every=CLOCK_EVERY, sampling_period_s=_loop(env).sampling_period_s
         )
     return builders
 
@@ -114,8 +114,12 @@ def _loop(env: gym.Env) -> EventTriggeredEnv:
     return loop
 
 
-def _spaces(env: gym.Env) -> tuple[gym.Space, gym.Space, tuple[str, ...]]:
-    return env.observation_space, env.action_space, tuple(_loop(env).observation_names)
+def _rule(trigger_class: Callable[..., RuleTrigger], env: gym.Env, **keywords: Any) -> RuleTrigger:
+    """A rule trigger class's trigger for ``env``, built with its own constructor arguments
+    (not :class:`RuleTrigger`'s): ``env``'s spaces, its observation names and ``keywords``."""
+    return trigger_class(
+        env.observation_space, env.action_space, tuple(_loop(env).observation_names), **keywords
+    )
 
 
 def _takes_every_transmission(env_id: str) -> bool:

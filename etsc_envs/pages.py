@@ -65,12 +65,19 @@ def feature_meanings(env: Any) -> tuple[dict[str, str], list[str]]:
     module): pattern → meaning for each bullet ``* ``pattern``, ... — meaning``, and the
     paragraphs after the bullets."""
     module = inspect.getmodule(type(_loop(env)))
+    if module is None:
+        raise TypeError(f"env's loop class {type(_loop(env)).__name__} has no module")
     tree = ast.parse(inspect.getsource(module))
     doc = ""
     for statement, following in zip(tree.body, tree.body[1:], strict=False):
         targets = statement.targets if isinstance(statement, ast.Assign) else []
         named = any(isinstance(t, ast.Name) and t.id == "FEATURE_NAMES" for t in targets)
-        if named and isinstance(following, ast.Expr) and isinstance(following.value, ast.Constant):
+        if (
+            named
+            and isinstance(following, ast.Expr)
+            and isinstance(following.value, ast.Constant)
+            and isinstance(following.value.value, str)
+        ):
             doc = inspect.cleandoc(following.value.value)
     meanings: dict[str, str] = {}
     paragraphs: list[str] = []

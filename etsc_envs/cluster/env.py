@@ -43,8 +43,7 @@ from etsc_envs.cluster.params import ClusterContainmentParams, replace_params
 from etsc_envs.cluster.picture import PICTURE
 from etsc_envs.cluster.topology import containment_targets, hull_distance
 from etsc_envs.core.keywords import document_keywords
-from etsc_envs.core.loop_env import EventTriggeredEnv
-from etsc_envs.core.multi_agent import agent_major_names, agent_metrics
+from etsc_envs.core.multi_agent import MultiAgentLoop, agent_major_names, agent_metrics
 from etsc_envs.core.vector_env import EventTriggeredVectorEnv
 
 FEATURE_NAMES = (
@@ -113,7 +112,7 @@ def cluster_model(params: ClusterContainmentParams, disturbance_phase: np.ndarra
 
 
 @document_keywords(ClusterContainmentParams)
-class ClusterContainmentCentralEnv(EventTriggeredEnv):
+class ClusterContainmentCentralEnv(MultiAgentLoop):
     """Attitude containment of a microsatellite cluster with one central trigger (paper 001).
 
     Args:

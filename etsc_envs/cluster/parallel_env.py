@@ -9,7 +9,7 @@ event fires, as eq. (15) does in the paper. All agents share one closed loop, th
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 from etsc_envs.cluster.env import ClusterContainmentCentralEnv
 from etsc_envs.cluster.params import ClusterContainmentParams
@@ -32,7 +32,8 @@ class ClusterContainmentEnv(EventTriggeredParallelEnv):
     reward is ``-‖σ_i - σ_d,i‖/cost_scale - transmission_penalty * transmitted_i``.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {
+    # Not a ClassVar: ParallelEnv declares metadata an instance attribute.
+    metadata: dict[str, Any] = {  # noqa: RUF012
         "name": "cluster_containment_v0",
         "render_modes": RenderModes(RENDER_MODES),
         "render_fps": 10,

@@ -38,7 +38,8 @@ def package_source_stamp(package: str) -> str:
     if hasattr(module, "__path__"):
         files = sorted(path for root in module.__path__ for path in Path(root).rglob("*.py"))
     else:
-        files = [Path(module.__file__)] if getattr(module, "__file__", None) else []
+        file = getattr(module, "__file__", None)
+        files = [Path(file)] if file else []
     entries = []
     for path in files:
         stat = path.stat()

@@ -25,7 +25,10 @@ def field_docs(params_class: type) -> dict[str, str]:
     """Field name → the string documenting it in ``params_class``'s source (fields without one
     map to ``""``)."""
     tree = ast.parse(textwrap.dedent(inspect.getsource(params_class)))
-    body = tree.body[0].body
+    definition = tree.body[0]
+    if not isinstance(definition, ast.ClassDef):
+        raise TypeError(f"params_class must be a class, got {params_class!r}")
+    body = definition.body
     docs = {field.name: "" for field in dataclasses.fields(params_class)}
     for statement, following in itertools.pairwise(body):
         if (
@@ -89,7 +92,8 @@ def document_keywords(params_class: type) -> Callable[[EnvClass], EnvClass]:
             for field in dataclasses.fields(params_class)
             if field.name not in taken
         ]
-        init.__signature__ = signature.replace(parameters=[*kept, *fields])
+        # typeshed declares no __signature__ on functions; inspect.signature reads it.
+        init.__signature__ = signature.replace(parameters=[*kept, *fields])  # pyright: ignore[reportAttributeAccessIssue]
         return env_class
 
     return decorate

@@ -80,10 +80,12 @@ def _llvm_fma(typingctx, left, right, addend):
     return signature, codegen
 
 
-@overload(fused_multiply_add, jit_options={"cache": True})
+# Numba's stubs: jit_options is a TypedDict without "cache", and an @intrinsic is called
+# without its typing context.
+@overload(fused_multiply_add, jit_options={"cache": True})  # pyright: ignore[reportArgumentType]
 def _fused_multiply_add_compiled(left, right, addend):
     def implementation(left, right, addend):
-        return _llvm_fma(left, right, addend)
+        return _llvm_fma(left, right, addend)  # pyright: ignore[reportCallIssue]
 
     return implementation
 

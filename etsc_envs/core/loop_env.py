@@ -103,7 +103,8 @@ class EventTriggeredEnv(gym.Env):
     next step) and the copy continues exactly as the original would.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {
+    # Not a ClassVar: Env declares metadata an instance attribute.
+    metadata: dict[str, Any] = {  # noqa: RUF012
         "render_modes": RenderModes(RENDER_MODES),
         "render_fps": RENDER_FPS,
     }
@@ -210,6 +211,10 @@ class EventTriggeredEnv(gym.Env):
         raise NotImplementedError
 
     def _paper_metrics(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """Named copies of the loop's signals at the current instant (for plots and tests)."""
         raise NotImplementedError
 
     def _settled_at_end(self, metrics: dict[str, Any]) -> bool:
@@ -490,14 +495,15 @@ class EventTriggeredEnv(gym.Env):
             return None
         transmissions = int(self.transmissions.sum())
         title = f"{type(self).__name__}   t = {self.time_s:.3f} s   transmissions = {transmissions}"
-        system = None
         picture = self.picture
+        system = None
         if picture is not None:
             trail = self._trace.note_snapshot(self.time_s, picture.snapshot(self))
 
-            def system(figure, region):
+            def draw_system(figure: Any, region: Any) -> None:
                 picture.draw(self, figure, region, trail)
 
+            system = draw_system
         frame = draw_frame(self._trace, self.channel_labels, title, self.horizon_s, system)
         if self._window is not None:
             self._window.show(frame)

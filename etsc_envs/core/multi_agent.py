@@ -8,7 +8,8 @@ multi-agent form from :class:`EventTriggeredParallelEnv`, which shares that loop
 transmit bits are gathered into the loop's action, each agent observes its own block of the
 loop's observation plus its own transmission clock, and is paid its own channel's reward.
 
-What the loop must provide (besides the :class:`EventTriggeredEnv` API):
+What the loop must provide (a :class:`MultiAgentLoop`, besides the :class:`EventTriggeredEnv`
+API):
 
 * ``agent_names``: one name per channel, in channel order;
 * ``agent_feature_names``: the names of one agent's features; the loop's observation starts
@@ -25,7 +26,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -55,7 +56,9 @@ def agent_metrics(
     for index, name in enumerate(agent_names):
         transmissions = int(arrays.transmissions[0, index])
         mean_s, min_s = interevent_summary(
-            transmissions, arrays.interevent_sum_s[0, index], arrays.interevent_min_s[0, index]
+            arrays.transmissions[0, index],
+            arrays.interevent_sum_s[0, index],
+            arrays.interevent_min_s[0, index],
         )
         record[name] = {
             "transmissions": transmissions,
@@ -66,7 +69,18 @@ def agent_metrics(
     return record
 
 
-def agent_observation_index(loop: EventTriggeredEnv) -> np.ndarray:
+class MultiAgentLoop(EventTriggeredEnv):
+    """A closed loop with one agent per channel, which :class:`EventTriggeredParallelEnv`
+    shares: a subclass sets :attr:`agent_names` and :attr:`agent_feature_names` in its
+    constructor (see the module docstring)."""
+
+    agent_names: tuple[str, ...]
+    """One name per channel, in channel order."""
+    agent_feature_names: tuple[str, ...]
+    """The names of one agent's features."""
+
+
+def agent_observation_index(loop: MultiAgentLoop) -> np.ndarray:
     """Where each agent's observation sits in the loop's: row ``i`` holds the positions of
     agent ``i``'s features followed by its transmission clock (``ValueError`` if the loop does
     not provide what the module docstring asks)."""
@@ -101,14 +115,15 @@ class EventTriggeredParallelEnv(ParallelEnv):
     at the horizon or after ``max_cycles`` steps; the last infos also hold ``episode_metrics``.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {
+    # Not a ClassVar: ParallelEnv declares metadata an instance attribute.
+    metadata: dict[str, Any] = {  # noqa: RUF012
         "name": "event_triggered_parallel_v0",
         "render_modes": RenderModes(RENDER_MODES),
         "render_fps": 10,
         "is_parallelizable": True,
     }
 
-    def __init__(self, loop: EventTriggeredEnv, max_cycles: int | None = None) -> None:
+    def __init__(self, loop: MultiAgentLoop, max_cycles: int | None = None) -> None:
         if max_cycles is not None and (
             isinstance(max_cycles, bool) or not isinstance(max_cycles, int) or max_cycles < 1
         ):
@@ -121,6 +136,8 @@ class EventTriggeredParallelEnv(ParallelEnv):
         self.agent_observation_names = (*loop.agent_feature_names, CLOCK_NAME)
         self._index = agent_observation_index(loop)
         box = loop.observation_space
+        if not isinstance(box, gym.spaces.Box):
+            raise TypeError(f"loop.observation_space must be a Box, got {box}")
         self._observation_spaces = {
             agent: gym.spaces.Box(box.low[rows], box.high[rows], dtype=np.float32)
             for agent, rows in zip(self.possible_agents, self._index, strict=True)

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from etsc_envs.triggers.base import TriggerPolicy
+    from etsc_envs.triggers.base import RuleTrigger
 
 SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
 """Multiples of a rule's default thresholds swept where the threshold is a free positive
@@ -39,7 +39,7 @@ class Rule:
     """An event rule of a paper's ids.
 
     Args:
-        trigger: its trigger policy class (its thresholds are constructor keywords).
+        trigger: its rule trigger class (its thresholds are constructor keywords).
         thresholds: the keywords of ``trigger`` that set how much error it tolerates before
             transmitting, at their default values (a fresh dict each call).
         sweep_scales: the multiples of ``thresholds()`` at which a Pareto front runs the rule.
@@ -48,7 +48,7 @@ class Rule:
             unused.
     """
 
-    trigger: type[TriggerPolicy]
+    trigger: type[RuleTrigger]
     thresholds: Callable[[], dict[str, float]]
     sweep_scales: tuple[float, ...] = SCALES
     sweep_points: tuple[Mapping[str, float], ...] = field(default=(), hash=False)
@@ -99,7 +99,7 @@ class Paper:
     reproduction: str = ""
 
     @property
-    def trigger(self) -> type[TriggerPolicy]:
+    def trigger(self) -> type[RuleTrigger]:
         """The paper's trigger policy class."""
         return self.rule.trigger
 

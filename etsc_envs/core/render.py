@@ -243,7 +243,7 @@ def draw_triad(
             solid_capstyle="round",
         )
         if labels is not None:
-            axes.annotate(labels[column], end, color=color, fontsize=7, alpha=alpha)
+            axes.annotate(labels[column], (end[0], end[1]), color=color, fontsize=7, alpha=alpha)
 
 
 def bare_axes(axes: Axes, extent: float) -> None:

@@ -676,4 +676,4 @@ def quat_to_euler321(q: np.ndarray) -> np.ndarray:
 @jit
 def quat_angle(q: np.ndarray) -> float:
     """Principal rotation angle ``2 atan2(‖q_v‖, |q4|)`` of a unit quaternion, in [0, π]."""
-    return 2.0 * np.arctan2(np.sqrt(q[:3] @ q[:3]), abs(q[3]))
+    return 2.0 * float(np.arctan2(np.sqrt(q[:3] @ q[:3]), abs(q[3])))

@@ -5,12 +5,14 @@ from __future__ import annotations
 import dataclasses
 import numbers
 from collections.abc import Iterable
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
+Choice = TypeVar("Choice")
 
-def _real_number(name: str, value: float, allowed: str) -> float:
+
+def _real_number(name: str, value: object, allowed: str) -> float:
     """``value`` as a float, or ``ValueError`` if it is not a real number (a string, say)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(
@@ -68,7 +70,7 @@ def require_rule_trigger(name: str, trigger: Any, n_channels: int) -> Any:
     return trigger
 
 
-def require_choice(name: str, value: str, choices: Iterable[str]) -> str:
+def require_choice(name: str, value: Choice, choices: Iterable[Choice]) -> Choice:
     """``value``, or ``ValueError`` listing the allowed choices."""
     choices = tuple(choices)
     if value not in choices:
@@ -76,7 +78,7 @@ def require_choice(name: str, value: str, choices: Iterable[str]) -> str:
     return value
 
 
-def require_bool(name: str, value: bool) -> bool:
+def require_bool(name: str, value: object) -> bool:
     """``value`` as a ``bool``, or ``ValueError`` unless it is ``True`` or ``False`` (a string
     such as ``"no"`` or a number is refused rather than read by its truth value)."""
     if not isinstance(value, bool | np.bool_):

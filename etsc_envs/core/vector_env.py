@@ -95,7 +95,8 @@ class EventTriggeredVectorEnv(VectorEnv):
     ``episode_metrics()``, ``state_dict()`` and parameters).
     """
 
-    metadata: ClassVar[dict[str, Any]] = {
+    # Not a ClassVar: VectorEnv declares metadata an instance attribute.
+    metadata: dict[str, Any] = {  # noqa: RUF012
         "render_modes": list(VECTOR_RENDER_MODES),
         "render_fps": RENDER_FPS,
         "autoreset_mode": AutoresetMode.NEXT_STEP,
@@ -191,7 +192,7 @@ class EventTriggeredVectorEnv(VectorEnv):
                 f"got {mask!r}"
             )
         infos: dict[str, Any] = {}
-        for index in np.flatnonzero(mask):
+        for index in np.flatnonzero(mask).tolist():
             _, info = self.envs[index].reset(seed=seeds[index], options=env_options or None)
             infos = self._add_info(infos, info, index)
         self._needs_reset[mask] = False
@@ -223,7 +224,7 @@ class EventTriggeredVectorEnv(VectorEnv):
         rewards = arrays.reward.copy()
         self.channel_rewards = arrays.channel_rewards.copy()
         infos: dict[str, Any] = {}
-        for index in np.flatnonzero(ended):
+        for index in np.flatnonzero(ended).tolist():
             env = self.envs[index]
             end_info = env.step_info(True)
             if self.autoreset_mode == AutoresetMode.SAME_STEP:
@@ -311,7 +312,7 @@ class EventTriggeredVectorEnv(VectorEnv):
                 )
         return steps_run
 
-    def render(self) -> tuple[np.ndarray, ...] | None:
+    def render(self) -> tuple[np.ndarray | None, ...] | None:
         """One frame per sub-environment with ``render_mode="rgb_array"``, else ``None``."""
         if self.render_mode is None:
             return None
@@ -381,7 +382,9 @@ class EventTriggeredVectorEnv(VectorEnv):
         """One seed per sub-environment, or ``ValueError``."""
         if seed is None:
             return [None] * self.num_envs
-        if isinstance(seed, int | np.integer) and not isinstance(seed, bool):
+        if isinstance(seed, bool):
+            raise ValueError(f"seed must be None, an int or {self.num_envs} seeds, got {seed!r}")
+        if isinstance(seed, int | np.integer):
             return [int(seed) + index for index in range(self.num_envs)]
         seeds = list(seed)
         if len(seeds) != self.num_envs:

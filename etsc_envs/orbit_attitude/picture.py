@@ -46,8 +46,9 @@ def draw(env: Any, figure: Figure, region: SubplotSpec, trail: np.ndarray) -> No
         labels=("radial", "along-track", "normal"),
     )  # fmt: skip
     earth = VIEW[:2] @ np.array([-0.7 * reach, 0.0, 0.0])
-    axes.annotate("", earth, xytext=(0.0, 0.0), arrowprops={"arrowstyle": "->", "color": "0.6"})
-    axes.text(*earth, "to Earth", fontsize=7, color="0.4", ha="center", va="bottom")
+    tip = (earth[0], earth[1])
+    axes.annotate("", tip, xytext=(0.0, 0.0), arrowprops={"arrowstyle": "->", "color": "0.6"})
+    axes.text(*tip, "to Earth", fontsize=7, color="0.4", ha="center", va="bottom")
     path = positions @ VIEW[:2].T
     axes.plot(path[:, 0], path[:, 1], color="0.45", linewidth=0.9)
     q_e, r_e = trail[-1, 0:4], trail[-1, 4:7]

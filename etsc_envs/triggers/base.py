@@ -518,7 +518,8 @@ class ClockTrigger(RuleTrigger):
             raise ValueError(
                 f"sampling_period_s must be a finite number > 0 (s), got {sampling_period_s!r}"
             )
-        channels = 1 if transmit_bits(action_space) is None else transmit_bits(action_space)
+        bits = transmit_bits(action_space)
+        channels = 1 if bits is None else bits
         times = time_since_transmission_indices(observation_names, channels)
         super().__init__(
             observation_space,

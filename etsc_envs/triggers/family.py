@@ -40,7 +40,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
@@ -392,6 +392,9 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
     kernel = family_rule(
         trigger_class.condition, trigger_class.conditions_per_channel, trigger_class.strict
     )
+    # Built with the paper trigger's own constructor arguments (spaces, observation names,
+    # thresholds), which RuleTrigger's signature does not describe.
+    paper_trigger = cast(Callable[..., RuleTrigger], trigger_class)
 
     class FamilyTrigger(RuleTrigger):
         rule = staticmethod(kernel)
@@ -412,13 +415,14 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
             if not math.isfinite(period) or period <= 0.0:
                 raise ValueError(f"sampling_period_s must be a finite number > 0, got {period!r}")
             thresholds = scaled_thresholds(trigger_class, point.factors)
-            inner = trigger_class(
+            inner = paper_trigger(
                 observation_space, action_space, observation_names, **keywords, **thresholds
             )
             self.point = point
             self.inner = inner
             names = tuple(observation_names)
-            channels = 1 if transmit_bits(action_space) is None else transmit_bits(action_space)
+            bits = transmit_bits(action_space)
+            channels = 1 if bits is None else bits
             times = time_since_transmission_indices(names, channels)
             bounds = [
                 instants_seconds(point.floor_instants, period),
@@ -549,8 +553,9 @@ class LearnedTrigger:
         families = {paper.trigger.__name__: paper.trigger for paper in PAPERS}
         if self.family not in families:
             raise ValueError(f"family must be one of {sorted(families)}, got {self.family!r}")
-        trigger_class = family_trigger_class(families[self.family])
-        return trigger_class(
+        # Built with FamilyTrigger's own constructor arguments (family_trigger_class).
+        family = cast(Callable[..., RuleTrigger], family_trigger_class(families[self.family]))
+        return family(
             observation_space,
             action_space,
             observation_names,
