@@ -159,7 +159,8 @@ def test_a_front_sweep_ships_for_every_id() -> None:
 def test_a_shipped_front_crosses_four_penalties_with_three_seeds(path: Path) -> None:
     config = load_sweep_config(path)
     assert config.kind == "front"
-    assert len(config.grid["env_kwargs.transmission_penalty"]) >= 4
+    penalty = "penalty" if config.learner == "search" else "env_kwargs.transmission_penalty"
+    assert len(config.grid[penalty]) >= 4
     assert len(config.grid["seed"]) >= 3
     assert Path(config.results_dir).parts[-3:-1] == ("runs", "sweeps")
 

@@ -265,13 +265,17 @@ def score(
 
 
 class Evaluator:
-    """Runs :func:`score` for many candidates at once: in spawned worker processes, or as Ray
-    tasks (a local Ray, or the cluster at ``address``)."""
+    """Runs :func:`score` for many candidates at once: in ``processes`` spawned worker
+    processes, as Ray tasks (``processes`` ``None``: a local Ray, or the cluster at
+    ``address``), or one after another in this process (``processes`` 0: a search that is
+    itself one of many trials run in parallel, :mod:`agents.sweep.learners`)."""
 
     def __init__(self, processes: int | None, address: str | None) -> None:
         self.pool: ProcessPoolExecutor | None = None
         self.ray: Any = None
-        if processes is not None:
+        if processes == 0:
+            self.description = "this process"
+        elif processes is not None:
             context = multiprocessing.get_context("spawn")
             self.pool = ProcessPoolExecutor(processes, mp_context=context)
             self.description = f"{processes} worker process(es)"
@@ -286,6 +290,8 @@ class Evaluator:
     def map(self, calls: list[tuple[Any, ...]]) -> list[dict[str, float]]:
         if self.pool is not None:
             return list(self.pool.map(score, *zip(*calls, strict=True)))
+        if self.ray is None:
+            return [score(*call) for call in calls]
         return self.ray.get([self.remote_score.remote(*call) for call in calls])
 
     def close(self) -> None:

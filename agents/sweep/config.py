@@ -8,6 +8,10 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
 * ``results_dir`` — the sweep's results folder: one subfolder per trial under ``trials/``
   (model, normalisation statistics, resolved config, evaluations), the sweep summary and
   Ray Tune's experiment state under ``tune/``;
+* ``learner: train`` — what a trial runs: ``train`` (one ``agents.train`` run, ``base`` a
+  training config) or ``search`` (one ``agents.search`` run, ``base`` a search config of
+  ``configs/search/``, whose keys ``overrides`` and ``grid`` then set: a front of the learned
+  trigger family over ``penalty`` × ``seed``); a search sweep is a ``front``;
 * ``kind`` — ``front`` (the trials form a reported front, e.g. transmission penalty × seed:
   every trial runs to its end, so neither a scheduler nor a search algorithm is allowed) or
   ``search`` (a hyperparameter search, which may use them);
@@ -48,12 +52,14 @@ import dataclasses
 import itertools
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from agents.search.cma_es import SearchConfig
+from agents.search.cma_es import config_from_dict as search_config_from_dict
 from agents.sweep.results import EVALUATION_METRICS, METRICS, SETTINGS_FILE, TRIALS_DIR
 from agents.train.config import (
     OPTIONAL_DEFAULTS,
@@ -65,6 +71,7 @@ from agents.train.config import (
 from etsc_envs.core.files import atomic_write_text
 
 KINDS = ("front", "search")
+LEARNERS = ("train", "search")
 SCHEDULERS = ("asha",)
 SEARCH_ALGORITHMS = ("optuna",)
 MODES = ("min", "max")
@@ -83,6 +90,7 @@ OPTIONAL_SWEEP_DEFAULTS: dict[str, Any] = {
     "mode": None,
     "cpus_per_trial": 1,
     "max_concurrent_trials": None,
+    "learner": "train",
 }
 NESTED_TRAINING_KEYS = ("env_kwargs", "hyperparameters", "evaluation_env_kwargs", "start_from")
 """Training-config keys whose value is a mapping that a dotted key may reach into."""
@@ -103,6 +111,7 @@ class SweepConfig:
     base: dict[str, Any]
     results_dir: str
     kind: str
+    learner: str
     grid: dict[str, list[Any]]
     search: dict[str, dict[str, list[Any]]]
     num_samples: int
@@ -190,12 +199,23 @@ class SweepConfig:
                 f"resume it with the settings it started with, or start another results_dir"
             )
 
-    def trial_config(self, values: Mapping[str, Any], out_dir: str | Path) -> TrainConfig:
-        """The validated training config of the trial with the swept ``values``."""
+    def trial_mapping(self, values: Mapping[str, Any], out_dir: str | Path) -> dict[str, Any]:
+        """The config of the trial with the swept ``values``, as the mapping its YAML holds."""
         raw = copy.deepcopy(self.base)
         for key, value in values.items():
             _assign(raw, key, value)
-        raw["out_dir"] = str(out_dir)
+        if self.learner == "train":
+            raw["out_dir"] = str(out_dir)
+        return raw
+
+    def trial_config(
+        self, values: Mapping[str, Any], out_dir: str | Path
+    ) -> TrainConfig | SearchConfig:
+        """The validated config of the trial with the swept ``values``: a training config, or
+        a search config for ``learner: search``."""
+        raw = self.trial_mapping(values, out_dir)
+        if self.learner == "search":
+            return search_config_from_dict(raw)
         return config_from_dict(raw)
 
 
@@ -213,17 +233,25 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
     _check_key_set(raw)
     values = {**OPTIONAL_SWEEP_DEFAULTS, **raw}
     kind = _check_choice("kind", values["kind"], KINDS)
+    learner = _check_choice("learner", values["learner"], LEARNERS)
+    if learner == "search" and kind != "front":
+        raise ValueError(
+            "sweep key 'kind' must be 'front' with learner 'search' (its trials are searches "
+            "over penalty x seed, each run to its end)"
+        )
+    check_key = _check_search_key if learner == "search" else _check_training_key
     base = _load_base(values["base"])
     overrides = _check_mapping("overrides", values["overrides"])
     for key, value in overrides.items():
-        _check_training_key("overrides", key)
+        check_key("overrides", key)
         _assign(base, key, value)
-    base["out_dir"] = "<trial folder>"
-    base["init_from"] = _absolute(base.get("init_from"))
-    start_from = base.get("start_from")
-    if isinstance(start_from, dict) and "selection_cache" in start_from:
-        start_from["selection_cache"] = _absolute(start_from["selection_cache"])
-    grid = _check_grid(values["grid"])
+    if learner == "train":
+        base["out_dir"] = "<trial folder>"
+        base["init_from"] = _absolute(base.get("init_from"))
+        start_from = base.get("start_from")
+        if isinstance(start_from, dict) and "selection_cache" in start_from:
+            start_from["selection_cache"] = _absolute(start_from["selection_cache"])
+    grid = _check_grid(values["grid"], check_key)
     search = _check_search(values["search"])
     overlap = sorted(set(grid) & set(search))
     if overlap:
@@ -248,6 +276,7 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
         base=base,
         results_dir=str(_check_path("results_dir", values["results_dir"]).resolve()),
         kind=kind,
+        learner=learner,
         grid=grid,
         search=search,
         num_samples=num_samples,
@@ -313,6 +342,19 @@ def _check_training_key(section: str, key: Any) -> str:
     return key
 
 
+def _check_search_key(section: str, key: Any) -> str:
+    """A search-config key (:class:`agents.search.cma_es.SearchConfig`), or ``keywords.<name>``
+    (an env keyword)."""
+    allowed = list(SearchConfig.__dataclass_fields__)
+    top, dot, inner = key.partition(".") if isinstance(key, str) else ("", "", "")
+    if top not in allowed or (dot and (top != "keywords" or not inner)):
+        raise ValueError(
+            f"sweep key {section!r}: unknown search-config key {key!r}; allowed: {allowed}, "
+            f"or 'keywords.name'"
+        )
+    return key
+
+
 def _load_base(value: Any) -> dict[str, Any]:
     path = _check_path("base", value)
     try:
@@ -347,10 +389,10 @@ def _absolute(path: Any) -> Any:
     return str(Path(path).resolve()) if isinstance(path, str) else path
 
 
-def _check_grid(value: Any) -> dict[str, list[Any]]:
+def _check_grid(value: Any, check_key: Callable[[str, Any], str]) -> dict[str, list[Any]]:
     grid = _check_mapping("grid", value)
     for key, values in grid.items():
-        _check_training_key("grid", key)
+        check_key("grid", key)
         if not isinstance(values, list) or not values:
             raise ValueError(f"sweep key 'grid.{key}' must be a non-empty list, got {values!r}")
         if key == "init_from":

@@ -23,8 +23,8 @@ from pathlib import Path
 from typing import Any
 
 from agents.sweep.config import SweepConfig
+from agents.sweep.learners import run_trial
 from agents.sweep.results import (
-    EVALUATIONS_FILE,
     SweepTrial,
     final_scores,
     one_line_error,
@@ -32,7 +32,6 @@ from agents.sweep.results import (
     trial_status,
     write_summary,
 )
-from agents.train.training import CHECKPOINT_DIR, latest_checkpoint, train
 
 
 def check_process_sweep(sweep: SweepConfig, processes: int) -> None:
@@ -54,11 +53,7 @@ def _run_trial(sweep: SweepConfig, values: dict[str, Any], folder: Path) -> str 
         return "interrupted"
     signal.signal(signal.SIGINT, signal.default_int_handler)  # a running trial stops on Ctrl-C
     try:
-        config = sweep.trial_config(values, folder)
-        resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
-        if not resume:  # an interrupted start's evaluations are not this run's
-            (folder / EVALUATIONS_FILE).unlink(missing_ok=True)
-        train(config, resume=resume)
+        run_trial(sweep, values, folder)
     except Exception as error:  # a failed trial is recorded, the others go on
         return one_line_error(error)
     except KeyboardInterrupt:  # the sweep's runner says how to continue

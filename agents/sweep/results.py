@@ -33,6 +33,9 @@ BEST_MODEL_FILE = "best_model.zip"
 EVALUATIONS_FILE = "evaluations.json"
 TRAIN_SUMMARY_FILE = "train_summary.json"
 CONFIG_FILE = "config.yaml"
+LEARNED_FILE = "learned.json"
+"""A search trial's learned trigger (``agents.search``), written last."""
+SEARCH_CURVE_FILE = "curve.json"
 STATUSES = ("finished", "failed", "incomplete")
 
 METRICS = (
@@ -86,7 +89,15 @@ def last_evaluation(folder: str | Path) -> dict[str, Any] | None:
 
 def final_scores(folder: str | Path) -> dict[str, Any] | None:
     """The metrics of a finished training run, from its ``train_summary.json`` (steps and the
-    mean return of its last episodes) and ``evaluations.json``; ``None`` if it did not finish."""
+    mean return of its last episodes) and ``evaluations.json``, or of a finished search (its
+    env steps and the chosen trigger's validation return, from ``curve.json``); ``None`` if it
+    did not finish."""
+    if (Path(folder) / LEARNED_FILE).is_file():
+        search = json.loads((Path(folder) / SEARCH_CURVE_FILE).read_text(encoding="utf-8"))
+        return {
+            "env_steps": search["search"]["env_steps"],
+            "validation_return": search["search"]["validation_return"],
+        }
     summary_path = Path(folder) / TRAIN_SUMMARY_FILE
     if not summary_path.is_file():
         return None
@@ -109,11 +120,14 @@ class SweepTrial:
 
     @property
     def model(self) -> Path:
-        """The model the trial is judged by (its normalisation statistics lie beside it): the
-        checkpoint of the best validation return (``best_model.zip``) where the run validated,
-        since the protocol chooses checkpoints on the validation set; else the final model."""
-        best = self.folder / BEST_MODEL_FILE
-        return best if best.is_file() else self.folder / MODEL_FILE
+        """The model the trial is judged by: a search's learned trigger; else (its
+        normalisation statistics lie beside it) the checkpoint of the best validation return
+        (``best_model.zip``) where the run validated, since the protocol chooses checkpoints on
+        the validation set; else the final model."""
+        for name in (LEARNED_FILE, BEST_MODEL_FILE):
+            if (self.folder / name).is_file():
+                return self.folder / name
+        return self.folder / MODEL_FILE
 
     def record(self, results_dir: Path) -> dict[str, Any]:
         """The trial's entry in ``sweep_summary.json`` (folder relative to ``results_dir``)."""
@@ -128,10 +142,11 @@ class SweepTrial:
 
 
 def training_finished(folder: str | Path) -> bool:
-    """Whether the training run in ``folder`` finished: ``agents.train`` writes its summary
-    last, after the model."""
+    """Whether the trial in ``folder`` finished: ``agents.train`` writes its summary last,
+    after the model, and ``agents.search`` its learned trigger after its last generation."""
     folder = Path(folder)
-    return (folder / MODEL_FILE).is_file() and (folder / TRAIN_SUMMARY_FILE).is_file()
+    trained = (folder / MODEL_FILE).is_file() and (folder / TRAIN_SUMMARY_FILE).is_file()
+    return trained or (folder / LEARNED_FILE).is_file()
 
 
 def trial_status(folder: Path, error: str | None) -> str:

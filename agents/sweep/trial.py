@@ -1,5 +1,5 @@
 """One trial of a sweep, as Ray Tune runs it: one ``agents.train`` run that reports its
-progress to Tune.
+progress to Tune, or one ``agents.search`` run (:mod:`agents.sweep.learners`).
 
 The trial's folder is ``results_dir/trials/<name>`` (:meth:`SweepConfig.trial_name`). A trial
 that Tune restarts after an interruption does not train again if its training had finished
@@ -18,6 +18,7 @@ from ray import tune
 from stable_baselines3.common.callbacks import BaseCallback
 
 from agents.sweep.config import SweepConfig
+from agents.sweep.learners import run_trial as run_learner
 from agents.sweep.results import (
     EVALUATIONS_FILE,
     final_scores,
@@ -25,7 +26,6 @@ from agents.sweep.results import (
     scores,
     training_finished,
 )
-from agents.train.training import CHECKPOINT_DIR, latest_checkpoint, train
 
 
 class TuneReportCallback(BaseCallback):
@@ -69,12 +69,11 @@ def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
     name = sweep.trial_name(values, tune.get_context().get_trial_id())
     folder = sweep.trial_folder(name)
     if not training_finished(folder):
-        config = sweep.trial_config(values, folder)
-        resume = latest_checkpoint(folder / CHECKPOINT_DIR) is not None
-        if not resume:  # an interrupted start's evaluations are not this run's
-            (folder / EVALUATIONS_FILE).unlink(missing_ok=True)
-        reporter = TuneReportCallback(folder, config.total_timesteps, sweep.metric)
-        train(config, resume=resume, callbacks=[reporter])
+        callbacks = []
+        if sweep.learner == "train":
+            timesteps = int(sweep.trial_mapping(values, folder)["total_timesteps"])
+            callbacks.append(TuneReportCallback(folder, timesteps, sweep.metric))
+        run_learner(sweep, values, folder, callbacks)
     tune.report(final_scores(folder))
 
 
