@@ -12,11 +12,11 @@ scenario's record here equals :func:`baselines.episodes.run_episode`'s (or
 ``wall_time_s`` differs: it is the batch's wall time divided by ``K``. ``tests/test_batch.py``
 compares the two paths for every id.
 
-A self-triggered model (:class:`~baselines.self_triggered.SelfTriggeredPolicy`, Gymnasium ids)
+A self-triggered model (:class:`~etsc_envs.decisions.SelfTriggeredPolicy`, Gymnasium ids)
 runs decision by decision instead: the model is asked once per decision for the rows still
 running, and each row's interval (a hold, or a rule deciding until it fires) runs in one
 compiled call of its own sub-environment
-(:func:`~baselines.self_triggered.run_decision_interval`). The episode is the one the policy
+(:func:`~etsc_envs.decisions.run_decision_interval`). The episode is the one the policy
 gives stepped instant by instant, so every record's metrics are equal; only ``return`` may
 differ in its last bits, summed interval by interval (``tests/test_batch.py``).
 
@@ -49,9 +49,9 @@ from gymnasium.vector import AutoresetMode
 
 import etsc_envs
 from baselines.episodes import instants_bar
-from baselines.self_triggered import SelfTriggeredPolicy, run_decision_interval
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.vector_env import available_cores
+from etsc_envs.decisions import SelfTriggeredPolicy, run_decision_interval
 from etsc_envs.triggers.base import RuleTrigger
 
 PROGRESS_EVERY = 1000
@@ -251,8 +251,8 @@ def _run_decisions(
     """Every row's episode from ``observations`` (just after the reset) decision by decision:
     one batched choice of the model for the rows still running, then each row's interval in one
     compiled call of its own sub-environment
-    (:func:`~baselines.self_triggered.run_decision_interval`), the episode
-    :class:`~baselines.self_triggered.SelfTriggeredPolicy` runs instant by instant. Adds each
+    (:func:`~etsc_envs.decisions.run_decision_interval`), the episode
+    :class:`~etsc_envs.decisions.SelfTriggeredPolicy` runs instant by instant. Adds each
     row's return to ``returns`` and returns each row's episode metrics."""
     rows = vector_env.num_envs
     loops = vector_env.envs

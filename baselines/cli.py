@@ -14,14 +14,14 @@ import yaml
 
 import etsc_envs
 from baselines.episodes import run_episode, run_parallel_episode, to_jsonable
-from baselines.policies import load_sb3
-from baselines.self_triggered import decision_set_path, load_self_triggered
 from etsc_envs.core.compiled_loop import always_accepts
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.paper import RULE_NAMES
 from etsc_envs.core.validation import require_int_at_least
+from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy, decision_set_path
 from etsc_envs.papers import ids_with_rule, paper_of, rule_of
+from etsc_envs.sb3_models import load_sb3
 from etsc_envs.triggers import AlwaysPolicy, PeriodicPolicy, SwitchedPeriodicPolicy
 from etsc_envs.triggers.base import (
     ClockTrigger,
@@ -33,7 +33,7 @@ from etsc_envs.triggers.family import LearnedTrigger
 
 POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP | learned:PATH"
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
-(:mod:`baselines.self_triggered`)."""
+(:mod:`etsc_envs.decisions`)."""
 
 
 def limit_torch_threads() -> None:
@@ -301,8 +301,25 @@ def _policy_for(
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")
         path = spec.removeprefix("sb3:")
         if decision_set_path(path).is_file():
-            return load_self_triggered(
-                path, observation_space, action_space, observation_names(), env_id
+            decisions = DecisionSet.load(path)
+            if decisions.env_id != env_id:
+                raise ValueError(
+                    f"sb3 model {path} takes self-triggered decisions in {decisions.env_id}, "
+                    f"not in {env_id}"
+                )
+            model = load_sb3(
+                path,
+                observation_space=observation_space,
+                action_space=decisions.action_space,
+                env_id=f"{env_id} (self-triggered, {decisions.n_actions} actions)",
+            )
+            return SelfTriggeredPolicy(
+                model,
+                decisions,
+                observation_space,
+                action_space,
+                observation_names(),
+                loop().sampling_period_s,
             )
         return load_sb3(
             path,

@@ -14,7 +14,7 @@ import pytest
 from agents.train.validation_callback import deployment
 from baselines.batch import run_batch, run_batch_in_processes
 from baselines.cli import episode_setup
-from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
+from etsc_envs.decisions import SelfTriggeredPolicy, decision_set_v1
 
 SHORT_HORIZONS = {
     "etsc/AttitudeTracking-v0": 2.0,
@@ -183,7 +183,7 @@ def test_self_triggered_decisions_run_decision_by_decision_as_instant_by_instant
     env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
     setup = episode_setup(env_id, env_args)
     unwrapped = setup.env.unwrapped
-    decisions = DecisionSet(
+    decisions = decision_set_v1(
         env_id, sampling_period_s=float(unwrapped.params.sampling_period_s), **decision_keywords
     )
     policy = SelfTriggeredPolicy(

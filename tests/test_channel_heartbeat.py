@@ -6,18 +6,24 @@ follower's instants itself take the same actions; bad arguments are named."""
 
 from __future__ import annotations
 
+import math
+
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.train.decisions import SelfTriggeredWrapper
 from baselines.cli import episode_setup
 from baselines.episodes import run_episode
-from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy, scaled_rule_trigger
+from etsc_envs.decisions import DecisionSet, decision_set_v1
 from etsc_envs.triggers import ClusterContainmentTrigger
-from etsc_envs.triggers.base import channel_heartbeat_trigger_class, instants_seconds
+from etsc_envs.triggers.base import (
+    channel_heartbeat_trigger_class,
+    instants_seconds,
+    timed_rule_class,
+)
 from tests.test_decisions import RecordedActions, ScriptedModel
+from tests.v1_decisions import deployed_policy, v1_wrapper
 
 CENTRAL = "etsc/ClusterContainmentCentral-v0"
 HORIZON_S = 20.0
@@ -89,8 +95,8 @@ def test_the_decision_runs_the_trigger_in_compiled_intervals_and_deployed():
     transmit/hold policy one instant at a time."""
     kwargs = {"max_exponent": 6, "factors": (0.5, 1.0), "rule_channel_heartbeat": [None, 150]}
     base = central_env()
-    wrapper = SelfTriggeredWrapper(base, **kwargs)
-    labels = [wrapper.decisions.label(wrapper.decisions.n_holds + i) for i in range(2)]
+    wrapper = v1_wrapper(base, **kwargs)
+    labels = [wrapper.decisions.label(len(wrapper.decisions.hold_indices) + i) for i in range(2)]
     assert labels == ["paper x0.5", "paper x1, channel heartbeat 150"]
     action = wrapper.decisions.action(labels[1])
     wrapper.reset(seed=5)
@@ -102,11 +108,8 @@ def test_the_decision_runs_the_trigger_in_compiled_intervals_and_deployed():
     np.testing.assert_array_equal(np.array(base.actions), reference)
     assert intervals > 50
     deployed_env = central_env()
-    policy = SelfTriggeredPolicy(
-        ScriptedModel(wrapper.decisions.action_space.n, fixed=action),
-        wrapper.schedule,
-        deployed_env.observation_space,
-        deployed_env.action_space,
+    policy = deployed_policy(
+        ScriptedModel(wrapper.decisions.action_space.n, fixed=action), wrapper, deployed_env
     )
     run_episode(deployed_env, policy, seed=5)
     np.testing.assert_array_equal(np.array(deployed_env.actions), reference)
@@ -121,14 +124,13 @@ def test_the_decision_runs_the_trigger_in_compiled_intervals_and_deployed():
         ({"rule_channel_heartbeat": 2**20 + 1}, "rule_channel_heartbeat must be an integer"),
         ({"rule_channel_heartbeat": [8]}, "one heartbeat per factor"),
         ({"rule_channel_heartbeat": [8, 0]}, "rule_channel_heartbeat must be an integer"),
-        ({"rule_channel_heartbeat": 8, "sampling_period_s": None}, "sampling_period_s"),
         ({"rule_channel_heartbeat": 8, "rule_floor": 4}, "one of the two"),
     ],
 )
 def test_a_decision_set_refuses_a_bad_channel_heartbeat(kwargs, message):
     arguments = {"env_id": CENTRAL, "factors": (0.5, 1.0), "sampling_period_s": 0.01, **kwargs}
     with pytest.raises(ValueError, match=message):
-        DecisionSet(**arguments)
+        decision_set_v1(**arguments)
 
 
 def test_a_channel_heartbeat_trigger_names_its_bad_arguments():
@@ -139,16 +141,17 @@ def test_a_channel_heartbeat_trigger_names_its_bad_arguments():
     with pytest.raises(TypeError, match="heartbeat_s"):
         heartbeat_class(*spaces(env))
     with pytest.raises(ValueError, match="floor_s and heartbeat_s"):
-        scaled_rule_trigger(CENTRAL, 1.0, *spaces(env), floor_s=0.1, heartbeat_s=0.1)
+        timed_rule_class(ClusterContainmentTrigger, floor_s=0.1, heartbeat_s=0.1)
 
 
 def test_channel_heartbeats_survive_a_save_and_a_load(tmp_path):
-    decisions = DecisionSet(
+    decisions = decision_set_v1(
         CENTRAL, factors=(0.5, 1.0), rule_channel_heartbeat=[None, 256], sampling_period_s=0.01
     )
     decisions.save(tmp_path / "model.zip")
     loaded = DecisionSet.load(tmp_path / "model.zip")
-    assert loaded == decisions and loaded.channel_heartbeats == (None, 256)
+    beats = [loaded.actions[i].point.heartbeat_instants for i in loaded.trigger_indices]
+    assert loaded == decisions and beats == [math.inf, 256]
 
 
 @pytest.mark.parametrize("heartbeat", [0, 2.5, True])

@@ -15,12 +15,11 @@ from agents.train.decision_selection import (
     select_decision,
     stand_alone_spec,
 )
-from agents.train.imitation import FixedDecision
 from agents.train.training import main
 from agents.train.validation_callback import deployment, set_summary
 from baselines.batch import run_batch
 from baselines.cli import episode_setup
-from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
+from etsc_envs.decisions import FixedDecision, SelfTriggeredPolicy, decision_set_v1
 from etsc_envs.protocol import scenario_set
 from etsc_envs.triggers.base import RuleTrigger
 
@@ -31,7 +30,7 @@ SET_SIZE = 2
 
 
 def selection_at(penalty: float) -> dict:
-    decisions = DecisionSet(ATTITUDE, max_exponent=3, factors=(1.0, 4.0))
+    decisions = decision_set_v1(ATTITUDE, max_exponent=3, factors=(1.0, 4.0))
     kwargs = {**SHORT, "randomize": True, "transmission_penalty": penalty}
     return select_decision(ATTITUDE, kwargs, decisions, SET_SIZE, CANDIDATES)
 
@@ -82,7 +81,7 @@ def test_runs_that_differ_in_lambda_alone_share_the_candidates_runs(tmp_path):
     """The first selection writes the unpriced runs into the cache; a selection at another λ
     reads them (a changed file shows it was read) and prices them at its own λ, which gives
     what running at that λ gives."""
-    decisions = DecisionSet(ATTITUDE, max_exponent=3, factors=(1.0, 4.0))
+    decisions = decision_set_v1(ATTITUDE, max_exponent=3, factors=(1.0, 4.0))
     cache = tmp_path / "cache"
 
     def select(penalty: float) -> dict:
@@ -97,13 +96,13 @@ def test_runs_that_differ_in_lambda_alone_share_the_candidates_runs(tmp_path):
     record["candidates"]["hold 4"]["mean_cost"] = -1.0
     written.write_text(json.dumps(record), encoding="utf-8")
     assert select(3.0)["candidates"]["hold 4"]["mean_cost"] == -1.0
-    other = DecisionSet(ATTITUDE, max_exponent=2, factors=(1.0, 4.0))
+    other = decision_set_v1(ATTITUDE, max_exponent=2, factors=(1.0, 4.0))
     select_decision(ATTITUDE, SHORT, other, SET_SIZE, CANDIDATES, cache)
     assert len(list(cache.iterdir())) == 2  # another decision set: runs of its own
 
 
 def test_an_unknown_candidate_is_refused_by_name():
-    decisions = DecisionSet(ATTITUDE, max_exponent=3)
+    decisions = decision_set_v1(ATTITUDE, max_exponent=3)
     with pytest.raises(ValueError, match=r"start_from\.candidates: 'hold 64'"):
         select_decision(ATTITUDE, SHORT, decisions, SET_SIZE, ["hold 1", "hold 64"])
 
@@ -236,7 +235,7 @@ def test_a_stand_alone_trigger_takes_the_constant_decisions_actions(
     records of the deployed decision policy (run decision by decision, the episode of the
     per-instant deployment: tests/test_batch.py): the same transmissions, cost and failure, and
     the same return up to the order of its sum."""
-    decisions = DecisionSet(env_id, **decision_keywords)
+    decisions = decision_set_v1(env_id, **decision_keywords)
     seeds = scenario_set("validation", SET_SIZE).seeds
     setup = episode_setup(env_id, env_kwargs)
     deployed = deployment(setup, decisions)
@@ -261,10 +260,10 @@ def test_a_stand_alone_trigger_takes_the_constant_decisions_actions(
 def test_decisions_with_a_forced_transmission_or_a_shield_run_as_decisions():
     """A heartbeat's or a floor's forced transmission at each decision instant, and a shield
     that may replace a choice, have no stand-alone trigger: those run as decisions."""
-    heartbeat = DecisionSet(ATTITUDE, max_exponent=3, factors=(2.0,), rule_heartbeat=True)
+    heartbeat = decision_set_v1(ATTITUDE, max_exponent=3, factors=(2.0,), rule_heartbeat=True)
     assert stand_alone_spec(heartbeat, heartbeat.action("paper x2, heartbeat 8")) is None
     assert stand_alone_spec(heartbeat, heartbeat.action("hold 8")) == ("periodic", {"every": 8})
-    shielded = DecisionSet(
+    shielded = decision_set_v1(
         "etsc/InnerFormation-v0", max_exponent=3, shield_multiple=2.0, sampling_period_s=0.01
     )
     assert stand_alone_spec(shielded, shielded.action("hold 1")) is None

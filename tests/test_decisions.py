@@ -12,16 +12,17 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.train.decisions import SelfTriggeredWrapper, interval_env
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
 from baselines.evaluate import evaluate
-from baselines.policies import load_sb3, takes_action_masks
-from baselines.self_triggered import DecisionSet, SelfTriggeredPolicy
+from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy, decision_set_v1
+from etsc_envs.decisions.wrappers import interval_env
 from etsc_envs.papers import paper_of
+from etsc_envs.sb3_models import load_sb3, takes_action_masks
 from etsc_envs.triggers import PeriodicPolicy
 from etsc_envs.triggers.asteroid import AsteroidShield
 from etsc_envs.triggers.inner_formation import InnerFormationShield, default_error_time_thresholds
+from tests.v1_decisions import caps_of, deployed_policy, factors_of, v1_wrapper
 
 ATTITUDE = "etsc/AttitudeTracking-v0"
 FORMATION = "etsc/InnerFormation-v0"
@@ -65,7 +66,7 @@ def wrapper_actions(env_id: str, model, **kwargs) -> tuple[list[np.ndarray], lis
     """Transmit/hold actions of one seeded episode of the wrapper driven by ``model``, and the
     infos of its decisions."""
     base = recorded(env_id)
-    wrapper = SelfTriggeredWrapper(base, **kwargs)
+    wrapper = v1_wrapper(base, **kwargs)
     obs, _ = wrapper.reset(seed=SEED)
     infos, done = [], False
     while not done:
@@ -92,9 +93,9 @@ def paper_policy(env_id: str):
 
 
 def deployed(env_id: str, model, **kwargs) -> SelfTriggeredPolicy:
-    wrapper = SelfTriggeredWrapper(gym.make(env_id, horizon_s=HORIZON_S), **kwargs)
+    wrapper = v1_wrapper(gym.make(env_id, horizon_s=HORIZON_S), **kwargs)
     env = wrapper.env
-    return SelfTriggeredPolicy(model, wrapper.schedule, env.observation_space, env.action_space)
+    return deployed_policy(model, wrapper, env)
 
 
 def assert_same(first: list[np.ndarray], second: list[np.ndarray]) -> None:
@@ -104,8 +105,8 @@ def assert_same(first: list[np.ndarray], second: list[np.ndarray]) -> None:
 
 @pytest.mark.parametrize("env_id", [ATTITUDE, FORMATION])
 def test_follow_the_paper_is_the_paper_trigger(env_id):
-    decisions = DecisionSet(env_id, max_exponent=3)
-    follow = decisions.n_holds + decisions.factors.index(1.0)
+    decisions = decision_set_v1(env_id, max_exponent=3)
+    follow = len(decisions.hold_indices) + factors_of(decisions).index(1.0)
     actions, _ = wrapper_actions(env_id, ScriptedModel(0, fixed=follow), max_exponent=3)
     paper = policy_actions(env_id, paper_policy(env_id))
     assert np.array(paper).any()
@@ -123,7 +124,7 @@ def test_hold_is_the_clock():
 @pytest.mark.parametrize(("env_id", "shield"), [(ATTITUDE, None), (FORMATION, 0.5)])
 def test_deployed_policy_takes_the_training_decisions(env_id, shield):
     kwargs = {"max_exponent": 4, "shield_multiple": shield}
-    model = ScriptedModel(DecisionSet(env_id, max_exponent=4).action_space.n)
+    model = ScriptedModel(decision_set_v1(env_id, max_exponent=4).action_space.n)
     actions, infos = wrapper_actions(env_id, model, **kwargs)
     assert len({info["action"] for info in infos}) > 3
     assert_same(actions, policy_actions(env_id, deployed(env_id, model, **kwargs)))
@@ -131,7 +132,7 @@ def test_deployed_policy_takes_the_training_decisions(env_id, shield):
 
 def decision_episode(env: gym.Env, model, **kwargs) -> list[tuple]:
     """Every decision's result of one seeded episode of the wrapper over ``env``."""
-    wrapper = SelfTriggeredWrapper(env, **kwargs)
+    wrapper = v1_wrapper(env, **kwargs)
     obs, _ = wrapper.reset(seed=SEED)
     results, done = [], False
     while not done:
@@ -147,7 +148,7 @@ def test_compiled_holds_equal_the_per_instant_path(env_id, shield):
     """Under gym.make's own wrappers the holds run in compiled intervals; under any other
     wrapper (here the recorder) every instant is an env.step; both give the same episode."""
     kwargs = {"max_exponent": 5, "shield_multiple": shield}
-    model = ScriptedModel(DecisionSet(env_id, max_exponent=5).action_space.n)
+    model = ScriptedModel(decision_set_v1(env_id, max_exponent=5).action_space.n)
     plain, recorder = gym.make(env_id, horizon_s=HORIZON_S), recorded(env_id)
     assert interval_env(plain) is plain.unwrapped and interval_env(recorder) is None
     compiled = decision_episode(plain, model, **kwargs)
@@ -167,11 +168,11 @@ def test_a_rule_cap_ends_follow_the_paper_intervals(factors, rule_cap):
     its factor's cap, in the compiled path and instant by instant alike, and the deployed
     policy takes the same transmit/hold actions."""
     kwargs = {"max_exponent": 3, "factors": factors, "rule_cap": rule_cap}
-    decisions = DecisionSet(ATTITUDE, **kwargs)
+    decisions = decision_set_v1(ATTITUDE, **kwargs)
     caps = tuple(rule_cap) if isinstance(rule_cap, list) else (rule_cap,) * len(factors)
-    assert decisions.caps == caps
+    assert caps_of(decisions) == caps
     for index, cap in enumerate(caps):
-        follow = ScriptedModel(0, fixed=decisions.n_holds + index)
+        follow = ScriptedModel(0, fixed=len(decisions.hold_indices) + index)
         compiled = decision_episode(gym.make(ATTITUDE, horizon_s=HORIZON_S), follow, **kwargs)
         actions, infos = wrapper_actions(ATTITUDE, follow, **kwargs)
         elapsed = [info["elapsed_steps"] for info in infos[:-1]]
@@ -190,9 +191,11 @@ def test_the_heartbeat_action_is_the_rule_paired_with_a_heartbeat(env_id, factor
     from etsc_envs.triggers.base import HeartbeatPolicy
 
     kwargs = {"max_exponent": 3, "factors": (factor,), "rule_cap": heartbeat}
-    decisions = DecisionSet(env_id, **kwargs, rule_heartbeat=True)
-    assert decisions.label(decisions.n_holds) == f"paper x{factor:g}, heartbeat {heartbeat}"
-    follow = ScriptedModel(0, fixed=decisions.n_holds)
+    decisions = decision_set_v1(env_id, **kwargs, rule_heartbeat=True)
+    assert (
+        decisions.label(len(decisions.hold_indices)) == f"paper x{factor:g}, heartbeat {heartbeat}"
+    )
+    follow = ScriptedModel(0, fixed=len(decisions.hold_indices))
     kwargs["rule_heartbeat"] = True
     actions, infos = wrapper_actions(env_id, follow, **kwargs)
     compiled = decision_episode(gym.make(env_id, horizon_s=HORIZON_S), follow, **kwargs)
@@ -221,14 +224,14 @@ def test_a_heartbeat_per_factor_pairs_each_factor_with_its_own():
     from etsc_envs.triggers.base import HeartbeatPolicy
 
     kwargs = {"max_exponent": 3, "factors": (16.0, 2.0), "rule_cap": [12, 40]}
-    decisions = DecisionSet(ATTITUDE, **kwargs, rule_heartbeat=True)
-    labels = [decisions.label(decisions.n_holds + index) for index in range(2)]
+    decisions = decision_set_v1(ATTITUDE, **kwargs, rule_heartbeat=True)
+    labels = [decisions.label(len(decisions.hold_indices) + index) for index in range(2)]
     assert labels == ["paper x16, heartbeat 12", "paper x2, heartbeat 40"]
     env = gym.make(ATTITUDE, horizon_s=HORIZON_S)
     for index, (factor, heartbeat) in enumerate(
-        zip(decisions.factors, decisions.caps, strict=True)
+        zip(factors_of(decisions), caps_of(decisions), strict=True)
     ):
-        follow = ScriptedModel(0, fixed=decisions.n_holds + index)
+        follow = ScriptedModel(0, fixed=len(decisions.hold_indices) + index)
         actions, _ = wrapper_actions(ATTITUDE, follow, **kwargs, rule_heartbeat=True)
         rule = paper_of(ATTITUDE).trigger(
             env.observation_space,
@@ -242,17 +245,19 @@ def test_a_heartbeat_per_factor_pairs_each_factor_with_its_own():
 
 
 def test_a_cap_list_round_trips_and_bad_lists_name_themselves(tmp_path):
-    decisions = DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12, 40], rule_heartbeat=True)
+    decisions = decision_set_v1(
+        ATTITUDE, factors=(1.0, 2.0), rule_cap=[12, 40], rule_heartbeat=True
+    )
     decisions.save(tmp_path / "model.zip")
     assert DecisionSet.load(tmp_path / "model.zip") == decisions
     with pytest.raises(ValueError, match="one cap per factor"):
-        DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12])
+        decision_set_v1(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12])
     with pytest.raises(ValueError, match="rule_cap must be an integer"):
-        DecisionSet(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12, 0])
+        decision_set_v1(ATTITUDE, factors=(1.0, 2.0), rule_cap=[12, 0])
     with pytest.raises(ValueError, match="rule_cap must be an integer"):
-        DecisionSet(ATTITUDE, factors=(), rule_cap=0)
+        decision_set_v1(ATTITUDE, factors=(), rule_cap=0)
     with pytest.raises(ValueError, match=r"rule_floor \(16\) must be at most its factor's"):
-        DecisionSet(
+        decision_set_v1(
             "etsc/OrbitAttitudeTracking-v0",
             factors=(1.0, 2.0),
             rule_cap=[64, 8],
@@ -264,7 +269,7 @@ def test_a_cap_list_round_trips_and_bad_lists_name_themselves(tmp_path):
 def test_a_time_limit_sees_every_instant_of_a_hold():
     env = gym.make(ATTITUDE, horizon_s=HORIZON_S, max_episode_steps=50)
     assert interval_env(env) is None
-    wrapper = SelfTriggeredWrapper(env, max_exponent=6)
+    wrapper = v1_wrapper(env, max_exponent=6)
     wrapper.reset(seed=SEED)
     _, _, terminated, truncated, info = wrapper.step(6)  # hold 64
     assert truncated and not terminated and info["elapsed_steps"] == 50
@@ -276,9 +281,9 @@ def test_a_time_limit_sees_every_instant_of_a_hold():
 )
 def test_shield_lets_no_forbidden_hold_through(env_id, make_kwargs):
     kwargs = {"max_exponent": 10, "shield_multiple": 0.5}
-    n_actions = DecisionSet(env_id, max_exponent=10).action_space.n
+    n_actions = decision_set_v1(env_id, max_exponent=10).action_space.n
     base = RecordedActions(gym.make(env_id, **{"horizon_s": HORIZON_S, **make_kwargs}))
-    wrapper = SelfTriggeredWrapper(base, **kwargs)
+    wrapper = v1_wrapper(base, **kwargs)
     wrapper.reset(seed=SEED)
     longest_hold, largest_factor = 10, n_actions - 1
     replaced, decisions, done = 0, 0, False
@@ -322,7 +327,7 @@ def test_asteroid_shield_forbids_holds_that_leave_the_shell():
 # the wrapper is what is checked: Gymnasium's advice to check the unwrapped env does not apply
 @pytest.mark.filterwarnings("ignore:.*is different from the unwrapped version")
 def test_wrapper_passes_gymnasium_check_env():
-    env = SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.05), max_exponent=3)
+    env = v1_wrapper(gym.make(FORMATION, horizon_s=0.05), max_exponent=3)
     check_env(env, skip_render_check=True)
 
 
@@ -337,13 +342,13 @@ def test_wrapper_passes_gymnasium_check_env():
 )
 def test_bad_arguments_name_themselves(kwargs, argument):
     with pytest.raises(ValueError, match=argument):
-        SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.05), **kwargs)
+        v1_wrapper(gym.make(FORMATION, horizon_s=0.05), **kwargs)
 
 
 def test_factors_outside_the_trigger_range_name_themselves():
     env = gym.make("etsc/ClusterContainmentCentral-v0", horizon_s=0.05)
     with pytest.raises(ValueError, match="factors: 2 x"):
-        SelfTriggeredWrapper(env, factors=(1.0, 2.0))
+        v1_wrapper(env, factors=(1.0, 2.0))
 
 
 def test_an_unreadable_decision_set_names_its_file(tmp_path):
@@ -354,7 +359,7 @@ def test_an_unreadable_decision_set_names_its_file(tmp_path):
 
 def test_shield_only_where_the_paper_gives_one():
     with pytest.raises(ValueError, match="shield_multiple"):
-        DecisionSet(ATTITUDE, shield_multiple=2.0)
+        decision_set_v1(ATTITUDE, shield_multiple=2.0)
 
 
 @pytest.mark.parametrize("algorithm", ["MaskablePPO", "PPO"])
@@ -363,7 +368,7 @@ def test_short_training_saves_reloads_and_evaluates(tmp_path, algorithm):
     import stable_baselines3
 
     kwargs = {"max_exponent": 3, "shield_multiple": 2.0}
-    wrapper = SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.1), **kwargs)
+    wrapper = v1_wrapper(gym.make(FORMATION, horizon_s=0.1), **kwargs)
     module = sb3_contrib if algorithm == "MaskablePPO" else stable_baselines3
     model = getattr(module, algorithm)(
         "MlpPolicy", wrapper, n_steps=32, batch_size=32, n_epochs=1, device="cpu", seed=0
@@ -546,7 +551,8 @@ def test_the_rule_with_a_heartbeat_trains_pinned_and_deploys(tmp_path):
     )
     assert summary["imitation"]["decision"] == "paper x8, heartbeat 12, pinned at probability 0.9"
     decisions = DecisionSet.load(out_dir / "model.zip")
-    assert decisions.rule_cap == 12 and decisions.rule_heartbeat
+    triggers = [decisions.actions[i] for i in decisions.trigger_indices]
+    assert caps_of(decisions) == (12,) and all(action.send_first for action in triggers)
     result = evaluate(ATTITUDE, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
     assert result["episodes"][0]["steps"] == 100
 
@@ -568,7 +574,8 @@ def test_the_error_time_rule_trains_pinned_and_deploys(tmp_path):
         },
     )
     assert summary["imitation"]["decision"] == "error_time x2, pinned at probability 0.9"
-    assert DecisionSet.load(out_dir / "model.zip").rule == "error_time"
+    loaded = DecisionSet.load(out_dir / "model.zip")
+    assert {loaded.actions[i].rule for i in loaded.trigger_indices} == {"error_time"}
     env = gym.make(FORMATION, horizon_s=0.3)
     learned = RecordedActions(gym.make(FORMATION, horizon_s=0.3))
     run_episode(learned, make_policy(f"sb3:{out_dir / 'model.zip'}", env, {}, FORMATION), SEED)
@@ -590,7 +597,7 @@ def test_a_pinned_decision_is_the_policy_everywhere(tmp_path):
 
     from agents.train.imitation import pin_decision
 
-    env = SelfTriggeredWrapper(gym.make(FORMATION, horizon_s=0.1), max_exponent=3)
+    env = v1_wrapper(gym.make(FORMATION, horizon_s=0.1), max_exponent=3)
     model = PPO("MlpPolicy", env, n_steps=32, batch_size=32, n_epochs=1, seed=0)
     action = env.decisions.action("hold 4")
     margin = pin_decision(model, action, 0.9)
@@ -638,7 +645,7 @@ def test_agents_train_pins_the_cloned_decision(tmp_path):
 
 def test_the_decentralised_cluster_trains_pinned_and_deploys(tmp_path):
     """A PettingZoo id takes self-triggered decisions one follower at a time
-    (:class:`agents.train.follower_decisions.FollowerDecisionEnv`): a short pinned run completes,
+    (:class:`etsc_envs.decisions.FollowerDecisionEnv`): a short pinned run completes,
     its teammates act as the model, and the saved model deploys through ``sb3:`` on every
     follower of the PettingZoo env, as the pinned decision does."""
     cluster = "etsc/ClusterContainment-v0"
@@ -665,6 +672,6 @@ def test_a_decision_set_takes_its_ids_default_factors():
     from etsc_envs.core.paper import DEFAULT_FACTORS
 
     cluster = "etsc/ClusterContainment-v0"
-    assert DecisionSet(cluster).factors == paper_of(cluster).factors != DEFAULT_FACTORS
-    assert DecisionSet(ATTITUDE).factors == DEFAULT_FACTORS
-    assert DecisionSet(ATTITUDE, factors=[2, 8]).factors == (2.0, 8.0)
+    assert factors_of(decision_set_v1(cluster)) == paper_of(cluster).factors != DEFAULT_FACTORS
+    assert factors_of(decision_set_v1(ATTITUDE)) == DEFAULT_FACTORS
+    assert factors_of(decision_set_v1(ATTITUDE, factors=[2, 8])) == (2.0, 8.0)

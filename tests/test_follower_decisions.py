@@ -10,11 +10,11 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import etsc_envs
-from agents.train.follower_decisions import FollowerDecisionEnv
 from baselines.episodes import run_parallel_episode
-from baselines.self_triggered import SelfTriggeredPolicy
+from etsc_envs.decisions import FollowerDecisionEnv
 from etsc_envs.papers import paper_of
 from etsc_envs.triggers.base import HeartbeatPolicy
+from tests.v1_decisions import deployed_policy, v1_follower
 
 CLUSTER = "etsc/ClusterContainment-v0"
 HORIZON_S = 3.0
@@ -37,7 +37,7 @@ class ScriptedSharedModel:
 
 
 def follower_env(horizon_s: float = HORIZON_S, **kwargs) -> FollowerDecisionEnv:
-    return FollowerDecisionEnv(CLUSTER, {"horizon_s": horizon_s}, **{**DECISIONS, **kwargs})
+    return v1_follower(CLUSTER, {"horizon_s": horizon_s}, **{**DECISIONS, **kwargs})
 
 
 @pytest.mark.parametrize("seed", [0, 5])
@@ -62,10 +62,7 @@ def test_training_episode_is_the_deployed_policy_step_for_step(seed):
     assert len(actions) > 2 and decisions > 10  # the scripted decisions vary
 
     parallel = etsc_envs.make_parallel(CLUSTER, horizon_s=HORIZON_S)
-    agent = parallel.possible_agents[0]
-    deployed = SelfTriggeredPolicy(
-        model, env.schedule, parallel.observation_space(agent), parallel.action_space(agent)
-    )
+    deployed = deployed_policy(model, env, parallel)
     record, _ = run_parallel_episode(parallel, deployed, seed=seed)
     for name in parallel.possible_agents:
         assert training["agents"][name]["transmissions"] == record["agents"][name]["transmissions"]
@@ -147,7 +144,7 @@ def test_follower_env_passes_the_gymnasium_and_sb3_env_checkers():
 
 def test_bad_arguments_name_themselves():
     with pytest.raises(ValueError, match="env_id: 'etsc/ClusterContainmentCentral-v0'"):
-        FollowerDecisionEnv("etsc/ClusterContainmentCentral-v0")
+        v1_follower("etsc/ClusterContainmentCentral-v0")
     with pytest.raises(ValueError, match="gamma"):
         follower_env(gamma=1.5)
     with pytest.raises(ValueError, match="'paper x9' is not a decision"):

@@ -10,7 +10,7 @@ import pytest
 
 from agents.train.config import config_from_dict
 from agents.train.decision_selection import stand_alone_spec
-from baselines.self_triggered import DecisionSet
+from etsc_envs.decisions import DecisionSet, decision_set_v1
 from etsc_envs.triggers import PeriodicPolicy
 from tests.test_decision_selection import BASE_CONFIG
 from tests.test_decisions import (
@@ -26,12 +26,12 @@ HOLDS = (2, 5, 10, 20)
 
 
 def test_the_holds_are_the_actions_and_the_rule_comes_after_them():
-    decisions = DecisionSet(ATTITUDE, factors=(1.0, 4.0), holds=list(HOLDS))
-    assert decisions.holds == HOLDS
-    assert decisions.n_holds == 4 and decisions.action_space.n == 6
+    decisions = decision_set_v1(ATTITUDE, factors=(1.0, 4.0), holds=list(HOLDS))
+    assert tuple(decisions.actions[i].instants for i in decisions.hold_indices) == HOLDS
+    assert len(decisions.hold_indices) == 4 and decisions.action_space.n == 6
     labels = [decisions.label(action) for action in range(6)]
     assert labels == ["hold 2", "hold 5", "hold 10", "hold 20", "paper x1", "paper x4"]
-    assert decisions.caps == (20, 20)
+    assert tuple(decisions.actions[i].cap for i in decisions.trigger_indices) == (20, 20)
     assert stand_alone_spec(decisions, decisions.action("hold 10")) == (
         "periodic",
         {"every": 10},
@@ -50,16 +50,16 @@ def test_a_hold_of_any_length_is_its_clock(hold):
 
 
 def test_the_holds_survive_a_save_a_load_and_a_config(tmp_path):
-    decisions = DecisionSet(ATTITUDE, factors=(1.0,), holds=HOLDS)
+    decisions = decision_set_v1(ATTITUDE, factors=(1.0,), holds=HOLDS)
     decisions.save(tmp_path / "model.zip")
     assert DecisionSet.load(tmp_path / "model.zip") == decisions
     config = {**BASE_CONFIG, "out_dir": str(tmp_path / "run")}
     config["decisions"] = {"holds": list(HOLDS), "factors": [1.0]}
     config = config_from_dict(config)
-    assert config.decisions["holds"] == list(HOLDS)
+    assert [action["instants"] for action in config.decisions["actions"][:4]] == list(HOLDS)
 
 
 @pytest.mark.parametrize("holds", [[], [0, 5], [5, 2], [2, 2], [2.5], "10", [True]])
 def test_bad_holds_name_themselves(holds):
     with pytest.raises(ValueError, match="holds must be a non-empty ascending list"):
-        DecisionSet(ATTITUDE, holds=holds)
+        decision_set_v1(ATTITUDE, holds=holds)

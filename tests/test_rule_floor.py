@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.train.decisions import SelfTriggeredWrapper
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
-from baselines.self_triggered import DecisionSet
+from etsc_envs.decisions import DecisionSet, decision_set_v1
 from etsc_envs.triggers import OrbitAttitudeTrigger
 from etsc_envs.triggers.base import floored_trigger_class, instants_seconds
 from tests.test_decisions import RecordedActions
+from tests.v1_decisions import v1_wrapper
 
 ORBIT = "etsc/OrbitAttitudeTracking-v0"
 FORMATION = "etsc/InnerFormation-v0"
@@ -78,7 +78,7 @@ def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions(rule_fl
     (through compiled intervals)."""
     kwargs = {"max_exponent": 8, "factors": (1.0, 4.0), "rule_floor": rule_floor}
     base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
-    wrapper = SelfTriggeredWrapper(base, **kwargs)
+    wrapper = v1_wrapper(base, **kwargs)
     label = "paper x4, floor 48"
     if rule_floor == (48, 16):
         with pytest.raises(ValueError, match=label):
@@ -117,7 +117,6 @@ def test_the_command_line_refuses_a_bad_floor(arguments, message):
         ({"rule_floor": 0}, "rule_floor must be an integer"),
         ({"rule_floor": 2.5}, "rule_floor must be an integer"),
         ({"rule_floor": 64, "max_exponent": 5}, r"rule_floor \(64\) must be at most"),
-        ({"rule_floor": 8, "sampling_period_s": None}, "sampling_period_s"),
         ({"factors": (1.0, 4.0), "rule_floor": [2]}, "one floor per factor"),
         ({"factors": (1.0, 4.0), "rule_floor": [2, 0]}, "rule_floor must be an integer"),
         ({"factors": (1.0, 4.0), "rule_floor": [2, None]}, "rule_floor must be an integer"),
@@ -127,18 +126,18 @@ def test_the_command_line_refuses_a_bad_floor(arguments, message):
 def test_a_decision_set_refuses_a_bad_floor(kwargs, message):
     arguments = {"env_id": ORBIT, "sampling_period_s": SAMPLING_PERIOD_S, **kwargs}
     with pytest.raises(ValueError, match=message):
-        DecisionSet(**arguments)
+        decision_set_v1(**arguments)
 
 
 def test_the_floor_names_its_actions_and_bad_floors_name_themselves():
-    decisions = DecisionSet(
+    decisions = decision_set_v1(
         ORBIT, factors=(4.0,), rule_floor=64, sampling_period_s=SAMPLING_PERIOD_S
     )
-    assert decisions.label(decisions.n_holds) == "paper x4, floor 64"
-    paired = DecisionSet(
+    assert decisions.label(len(decisions.hold_indices)) == "paper x4, floor 64"
+    paired = decision_set_v1(
         ORBIT, factors=(0.3, 1.0), rule_floor=[2, 8], sampling_period_s=SAMPLING_PERIOD_S
     )
-    labels = [paired.label(paired.n_holds + index) for index in range(2)]
+    labels = [paired.label(len(paired.hold_indices) + index) for index in range(2)]
     assert labels == ["paper x0.3, floor 2", "paper x1, floor 8"]
     env = gym.make(ORBIT, horizon_s=0.05)
     with pytest.raises(ValueError, match="floor_s"):
@@ -165,9 +164,10 @@ class ObservationLog:
 
 
 def test_floors_per_factor_survive_a_save_and_a_load(tmp_path):
-    decisions = DecisionSet(
+    decisions = decision_set_v1(
         ORBIT, factors=(0.3, 1.0), rule_floor=[2, 8], sampling_period_s=SAMPLING_PERIOD_S
     )
     decisions.save(tmp_path / "model.zip")
     loaded = DecisionSet.load(tmp_path / "model.zip")
-    assert loaded == decisions and loaded.floors == (2, 8)
+    floors = [loaded.actions[i].point.floor_instants for i in loaded.trigger_indices]
+    assert loaded == decisions and floors == [2, 8]

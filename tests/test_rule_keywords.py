@@ -12,10 +12,11 @@ import pytest
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.train.config import config_from_dict
 from agents.train.decision_selection import stand_alone_spec
-from agents.train.decisions import SelfTriggeredWrapper
 from baselines.cli import make_policy
 from baselines.episodes import run_episode
-from baselines.self_triggered import DecisionSet
+from etsc_envs.decisions import DecisionSet, decision_set_v1, read_decision_set
+from etsc_envs.triggers import OrbitAttitudeTrigger
+from etsc_envs.triggers.family import scaled_thresholds
 from tests.test_decision_selection import BASE_CONFIG
 from tests.test_decisions import RecordedActions
 from tests.test_rule_floor import (
@@ -26,6 +27,7 @@ from tests.test_rule_floor import (
     ObservationLog,
     floored,
 )
+from tests.v1_decisions import v1_wrapper
 
 RELATIVE = {"a1": 2.4, "a2": 3.2}
 """Eq. (21)'s a1, a2 at four times the paper's (Theorem 2 needs a1 < 3.2, a2 < 3.6)."""
@@ -34,7 +36,7 @@ RELATIVE = {"a1": 2.4, "a2": 3.2}
 def floor_decision_actions(floor: int = 48, **decision_keywords) -> np.ndarray:
     """The transmit/hold actions of always choosing "paper x4, floor ``floor``"."""
     base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
-    wrapper = SelfTriggeredWrapper(
+    wrapper = v1_wrapper(
         base, max_exponent=8, factors=(4.0,), rule_floor=floor, **decision_keywords
     )
     action = wrapper.decisions.action(f"paper x4, floor {floor}")
@@ -74,20 +76,22 @@ def test_the_keywords_reach_the_floored_rule_and_change_its_transmissions():
 
 
 def test_a_plain_rule_actions_stand_alone_form_carries_the_keywords():
-    decisions = DecisionSet(ORBIT, max_exponent=3, factors=(2.0,), rule_keywords=RELATIVE)
+    decisions = decision_set_v1(ORBIT, max_exponent=3, factors=(2.0,), rule_keywords=RELATIVE)
     spec = stand_alone_spec(decisions, decisions.action("paper x2"))
     assert spec == ("paper", {"gamma1": 0.002, "gamma2": 0.006, **RELATIVE})
 
 
 def test_keywords_survive_a_save_and_a_load(tmp_path):
-    decisions = DecisionSet(
+    decisions = decision_set_v1(
         ORBIT,
         factors=(4.0,),
         rule_floor=64,
         sampling_period_s=SAMPLING_PERIOD_S,
         rule_keywords={"a1": 2, "a2": 3.2},
     )
-    assert decisions.rule_keywords == {"a1": 2.0, "a2": 3.2}
+    action = decisions.actions[decisions.trigger_indices[0]]
+    thresholds = scaled_thresholds(OrbitAttitudeTrigger, action.point.factors)
+    assert (thresholds["a1"], thresholds["a2"]) == (2.0, 3.2)
     decisions.save(tmp_path / "model.zip")
     assert DecisionSet.load(tmp_path / "model.zip") == decisions
 
@@ -105,13 +109,13 @@ def test_keywords_survive_a_save_and_a_load(tmp_path):
 )
 def test_a_decision_set_refuses_bad_keywords(keywords, message):
     with pytest.raises(ValueError, match=message):
-        DecisionSet(ORBIT, factors=(4.0,), rule_keywords=keywords)
+        decision_set_v1(ORBIT, factors=(4.0,), rule_keywords=keywords)
 
 
 def test_a_keyword_outside_the_triggers_range_names_the_keywords():
     env = gym.make(ORBIT, horizon_s=0.05)
     with pytest.raises(ValueError, match=r"rule_keywords \{'a1': -1.0\}: a1 must be"):
-        SelfTriggeredWrapper(env, factors=(4.0,), rule_keywords={"a1": -1.0})
+        v1_wrapper(env, factors=(4.0,), rule_keywords={"a1": -1.0})
 
 
 def test_a_training_config_takes_the_keywords(tmp_path):
@@ -119,4 +123,7 @@ def test_a_training_config_takes_the_keywords(tmp_path):
     decisions = {"factors": [4.0], "rule_floor": 8, "rule_keywords": RELATIVE}
     config = {**BASE_CONFIG, "env_id": ORBIT, "env_kwargs": {"horizon_s": 0.05}}
     config.update(out_dir=str(tmp_path / "run"), decisions=decisions)
-    assert config_from_dict(config).decisions["rule_keywords"] == RELATIVE
+    decisions = read_decision_set(config_from_dict(config).decisions)
+    action = decisions.actions[decisions.trigger_indices[0]]
+    thresholds = scaled_thresholds(OrbitAttitudeTrigger, action.point.factors)
+    assert {name: thresholds[name] for name in RELATIVE} == RELATIVE

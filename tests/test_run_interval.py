@@ -12,9 +12,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from baselines.self_triggered import scaled_rule_trigger
 from etsc_envs import ENV_IDS
-from etsc_envs.papers import paper_of
+from etsc_envs.papers import paper_of, rule_of
 from etsc_envs.triggers import PeriodicPolicy
 
 SEED = 5
@@ -157,8 +156,20 @@ def test_an_interval_before_reset_asks_for_one():
 
 def paper_trigger(env: gym.Env, factor: float = 1.0):
     """The env's paper trigger with its threshold keywords scaled by ``factor``."""
-    names = env.unwrapped.observation_names
-    return scaled_rule_trigger(env.spec.id, factor, env.observation_space, env.action_space, names)
+    return scaled_rule_trigger(
+        env.spec.id,
+        factor,
+        env.observation_space,
+        env.action_space,
+        env.unwrapped.observation_names,
+    )
+
+
+def scaled_rule_trigger(env_id, factor, observation_space, action_space, names, rule="paper"):
+    """The stand-alone ``rule`` trigger of ``env_id`` with its thresholds scaled by ``factor``."""
+    chosen = rule_of(env_id, rule)
+    thresholds = {name: factor * value for name, value in chosen.thresholds().items()}
+    return chosen.trigger(observation_space, action_space, names, **thresholds)
 
 
 RULE_HORIZONS_S = {

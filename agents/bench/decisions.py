@@ -1,4 +1,4 @@
-"""Throughput of self-triggered decisions (:class:`agents.train.decisions.SelfTriggeredWrapper`).
+"""Throughput of self-triggered decisions (:class:`etsc_envs.decisions.SelfTriggeredWrapper`).
 
     python -m agents.bench.decisions [--env ID ...] [--repeats R] [--per-instant]
 
@@ -23,7 +23,7 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from agents.train.decisions import SelfTriggeredWrapper
+from etsc_envs.decisions import SelfTriggeredWrapper, decision_set_v1
 
 DEFAULT_IDS = ("etsc/AttitudeTracking-v0", "etsc/InnerFormation-v0")
 HOLD_ACTION = 6
@@ -42,7 +42,7 @@ def time_decisions(
     n_actions = int(wrapper.action_space.n)
     fixed = {
         "hold": HOLD_ACTION,
-        "paper": wrapper.decisions.n_holds + wrapper.decisions.factors.index(1.0),
+        "paper": wrapper.decisions.action("paper x1"),
     }
     actions = (
         np.full(decisions, fixed[policy])
@@ -64,7 +64,7 @@ def make_wrapper(env_id: str, per_instant: bool) -> SelfTriggeredWrapper:
     """The decision wrapper over ``gym.make(env_id)`` (behind a plain wrapper if
     ``per_instant``)."""
     env = gym.make(env_id)
-    return SelfTriggeredWrapper(gym.Wrapper(env) if per_instant else env)
+    return SelfTriggeredWrapper(gym.Wrapper(env) if per_instant else env, decision_set_v1(env_id))
 
 
 def rates(env_id: str, policy: str, repeats: int, per_instant: bool) -> dict[str, list[float]]:

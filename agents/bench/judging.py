@@ -3,7 +3,7 @@ instant.
 
     python -m agents.bench.judging ENV_ID --model PATH [--set-size K] [--repeats R]
 
-:func:`baselines.batch.run_batch` runs a :class:`~baselines.self_triggered.SelfTriggeredPolicy`
+:func:`baselines.batch.run_batch` runs a :class:`~etsc_envs.decisions.SelfTriggeredPolicy`
 decision by decision (one model call per decision for the rows still running, each interval in
 one compiled call); any other policy is asked once per sampling instant for the whole batch.
 This command times both on the first ``K`` scenarios of the test set, in one process: the

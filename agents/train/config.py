@@ -50,7 +50,7 @@ A config is a YAML mapping with these keys (the optional ones show their default
 
   * ``decision`` — with ``decisions`` (and only there; required), the decision to clone, by
     its label (``"paper x0.25"``, ``"hold 64"``:
-    :meth:`baselines.self_triggered.DecisionSet.label`;
+    :meth:`etsc_envs.decisions.DecisionSet.label`;
     :func:`agents.train.imitation.imitate_decision`), or ``best`` to choose it per run: the
     decision with the highest mean return on the first ``evaluation_scenarios`` validation
     scenarios at the run's env kwargs, its transmission penalty among them
@@ -70,12 +70,13 @@ A config is a YAML mapping with these keys (the optional ones show their default
     in their transmission penalty alone (a front's trials) share the candidates' validation
     runs (:func:`agents.train.decision_selection.select_decision`);
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
-  keywords of :class:`agents.train.decisions.SelfTriggeredWrapper` (``max_exponent``, ``factors``,
-  ``shield_multiple``, ``rule_cap``, ``rule_heartbeat``, ``rule``, ``rule_floor``,
-  ``rule_channel_heartbeat``, ``rule_keywords``, ``holds``; its ``gamma`` is
-  ``hyperparameters.gamma``), on a
-  ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
-  :class:`agents.train.follower_decisions.FollowerDecisionEnv`; cloning with
+  decision set's own JSON form (:mod:`etsc_envs.decisions.actions`: ``shield_multiple`` and
+  ``actions``, a list of ``{kind: hold, instants: N}`` and ``{kind: trigger, point: {...},
+  cap: N, send_first: ...}``; ``env_id`` is the config's; a version-1 block of keywords is
+  read as :func:`~etsc_envs.decisions.actions.read_v1` says), trained through
+  :class:`etsc_envs.decisions.SelfTriggeredWrapper` (its ``gamma`` is
+  ``hyperparameters.gamma``) on a ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
+  :class:`etsc_envs.decisions.FollowerDecisionEnv`; cloning with
   ``start_from.decision``). PPO, A2C and MaskablePPO then discount by elapsed instants
   (:mod:`agents.train.elapsed_discount`); the models are saved with their decision set beside
   them, so that ``sb3:`` deploys them as transmit/hold policies;
@@ -106,12 +107,11 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
 from agents.train.decision_selection import BEST_DECISION
-from agents.train.decisions import make_decision_env
 from baselines.cli import require_env_id
-from baselines.policies import require_model_fits
-from baselines.self_triggered import DecisionSet
 from etsc_envs.core.files import require_writable_folder
+from etsc_envs.decisions import DecisionSet, make_decision_env, read_decision_set
 from etsc_envs.protocol import require_training_seeds
+from etsc_envs.sb3_models import require_model_fits
 
 ALGORITHMS: dict[str, type[BaseAlgorithm]] = {
     "PPO": PPO,
@@ -415,8 +415,8 @@ def _check_decisions(
     env_kwargs: dict[str, Any],
     start_from: StartFrom | None,
 ) -> dict[str, Any] | None:
-    """``values["decisions"]`` if it is null or keywords that build a
-    :class:`~agents.train.decisions.SelfTriggeredWrapper` for ``env_id``, which
+    """``values["decisions"]`` (null, or a decision set's JSON form for ``env_id``:
+    :func:`~etsc_envs.decisions.read_decision_set`) as the set's version-2 JSON form, which
     ``start_from`` fits (:meth:`StartFrom.require_fits`)."""
     if values["decisions"] is None:
         if algorithm == "MaskablePPO":
@@ -424,23 +424,9 @@ def _check_decisions(
         if start_from is not None:
             start_from.require_fits(None)
         return None
-    decisions = _check_mapping("decisions", values["decisions"])
-    allowed = (
-        "max_exponent",
-        "factors",
-        "shield_multiple",
-        "rule_cap",
-        "rule_heartbeat",
-        "rule",
-        "rule_floor",
-        "rule_channel_heartbeat",
-        "rule_keywords",
-        "holds",
-    )
-    unknown = sorted(set(decisions) - set(allowed))
-    if unknown:
-        raise ValueError(f"config key 'decisions': {unknown} are not among {list(allowed)}")
+    block = _check_mapping("decisions", values["decisions"])
     try:
+        decisions = read_decision_set(block, env_id)
         wrapper = make_decision_env(env_id, env_kwargs, decisions)
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
@@ -449,7 +435,7 @@ def _check_decisions(
             start_from.require_fits(wrapper.decisions)
     finally:
         wrapper.close()
-    return decisions
+    return decisions.to_json()
 
 
 def _check_algorithm_fits_env(

@@ -1,6 +1,6 @@
 """Choose the decision a self-triggered learner starts from, per transmission penalty.
 
-Every action of a :class:`~baselines.self_triggered.DecisionSet` taken at every decision is a
+Every action of a :class:`~etsc_envs.decisions.DecisionSet` taken at every decision is a
 baseline of its own: "hold 2^j" is the clock every 2^j instants, "paper × f" the paper's rule
 at f times its threshold (with a heartbeat or a floor where the set pairs them). Which of
 them a learner should start from depends on the price of a transmission: the reward of an
@@ -24,26 +24,20 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
-
-from agents.train.imitation import FixedDecision
 from agents.train.validation_callback import deployment, set_summary
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
-from baselines.self_triggered import (
-    DecisionSet,
-    IntervalSchedule,
-    SelfTriggeredPolicy,
-    rule_arguments,
-)
 from etsc_envs.core.files import atomic_write_text
+from etsc_envs.decisions import DecisionSet, FixedDecision, Hold, SelfTriggeredPolicy
 from etsc_envs.protocol import scenario_set
+from etsc_envs.triggers.family import FamilyPoint, scaled_thresholds
 
 BEST_DECISION = "best"
 """The ``start_from.decision`` that asks :func:`select_decision` to choose per config."""
@@ -51,40 +45,44 @@ BEST_DECISION = "best"
 
 def stand_alone_spec(decisions: DecisionSet, action: int) -> tuple[str, dict[str, Any]] | None:
     """The stand-alone trigger (``--policy`` name and arguments) whose every action equals
-    always taking ``action`` of ``decisions``, where there is one: "hold N" sends every channel
-    every N instants from the first (``periodic``, ``every=N``); "paper × f" without a
-    heartbeat or a floor lets the rule at f times its threshold decide every instant, the
-    decision instants included, and a capped interval hands over to the same rule (the rule
-    named by the set, its thresholds scaled, with the set's ``rule_keywords`` and the action's
-    heartbeat per channel if it has one: ``channel_heartbeat=H``). ``None`` for a rule action
-    with a heartbeat or a floor (their stand-alone forms, where the suite has one, answer in
-    Python every instant as the decision policy does, so there is nothing to gain) and for
-    every action of a shielded set (the shield may replace a choice)."""
+    always taking ``action`` of ``decisions``, where there is one: a hold of N sends every
+    channel every N instants from the first (``periodic``, ``every=N``); a trigger action that
+    does not send first, whose point is its rule's thresholds scaled (with a heartbeat per
+    channel if it has one: ``channel_heartbeat=H``), lets that rule decide every instant, the
+    decision instants included, and a capped interval hands over to the same rule. ``None`` for
+    other trigger actions (their stand-alone forms answer in Python every instant as the
+    decision policy does, so there is nothing to gain) and for every action of a shielded set
+    (the shield may replace a choice)."""
     if decisions.shield_multiple is not None:
         return None
-    if action < decisions.n_holds:
-        return "periodic", {"every": int(decisions.hold_steps[action])}
-    if decisions.rule_sends_first:
+    chosen = decisions.actions[action]
+    if isinstance(chosen, Hold):
+        return "periodic", {"every": chosen.instants}
+    point = chosen.point
+    plain = FamilyPoint(point.factors, heartbeat_instants=point.heartbeat_instants)
+    if chosen.send_first or point != plain:
         return None
-    index = action - decisions.n_holds
-    arguments = rule_arguments(
-        decisions.env_id, decisions.factors[index], decisions.rule, decisions.rule_keywords
-    )
-    channel_heartbeat = decisions.channel_heartbeats[index]
-    if channel_heartbeat is not None:
-        arguments["channel_heartbeat"] = channel_heartbeat
-    return decisions.rule, arguments
+    trigger = chosen.trigger_class(decisions.env_id)
+    thresholds = scaled_thresholds(trigger, point.factors)
+    named = {kw for group in point.factors for kw in trigger.threshold_groups[group]}
+    arguments: dict[str, Any] = {
+        **{kw: value for kw, value in thresholds.items() if kw in named},
+        **chosen.keywords,
+    }
+    if math.isfinite(point.heartbeat_instants):
+        arguments["channel_heartbeat"] = int(point.heartbeat_instants)
+    return chosen.rule, arguments
 
 
 def constant_decision_policy(
     setup: EpisodeSetup,
-    deployed: tuple[IntervalSchedule, gym.Space, gym.Space],
+    deployed: tuple[Any, ...],
     decisions: DecisionSet,
     action: int,
 ) -> Any:
     """A transmit/hold policy that always takes ``action`` of ``decisions``: its stand-alone
     trigger where :func:`stand_alone_spec` names one, else the deployed decision policy
-    (``deployed``: :func:`agents.train.validation_callback.deployment`'s schedule and spaces)."""
+    (``deployed``: :func:`agents.train.validation_callback.deployment`'s set and spaces)."""
     spec = stand_alone_spec(decisions, action)
     if spec is None:
         return SelfTriggeredPolicy(FixedDecision(action), *deployed)

@@ -1,7 +1,7 @@
 """Discounting by elapsed time for Stable-Baselines3's on-policy algorithms.
 
 Between two self-triggered decisions ``n`` sampling instants apart
-(:class:`agents.train.decisions.SelfTriggeredWrapper`, ``info["elapsed_steps"] = n``) the return
+(:class:`etsc_envs.decisions.SelfTriggeredWrapper`, ``info["elapsed_steps"] = n``) the return
 should be discounted by ``gamma ** n``, ``gamma`` being the per-instant discount, so that it
 means what the per-instant return means; SB3 discounts every transition by one ``gamma``. The
 rollout buffers here discount transition ``t`` by ``gamma ** n_t`` in the returns and in GAE

@@ -14,7 +14,7 @@ then trains the policy's action head to reproduce its decisions (cross-entropy) 
 head to predict the discounted returns of the collected episodes.
 
 :func:`imitate_decision` does the same for self-triggered decisions
-(:class:`agents.train.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
+(:class:`etsc_envs.decisions.SelfTriggeredWrapper`): the demonstrator takes one fixed decision of
 the set (the better of the paper's rule at some threshold and the best clock, chosen on the
 validation set), and returns are discounted by the instants each decision lasted. A fitted
 clone of one fixed decision agrees with it on the states the demonstrations visited only:
@@ -36,7 +36,7 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
 from baselines.cli import episode_setup
-from baselines.self_triggered import DecisionSet
+from etsc_envs.decisions import DecisionSet, FixedDecision
 
 
 def paper_trigger(env_id: str, env_kwargs: dict[str, Any]) -> Any:
@@ -161,22 +161,6 @@ def imitate_paper_trigger(
         "demonstrated_transmit_rate": float(np.mean(actions)),
         **summary,
     }
-
-
-class FixedDecision:
-    """The demonstrator of :func:`imitate_decision`: one decision, always (SB3's ``predict``)."""
-
-    def __init__(self, action: int) -> None:
-        self.action = int(action)
-
-    def predict(
-        self,
-        observation: np.ndarray,
-        state: Any = None,
-        episode_start: np.ndarray | None = None,
-        deterministic: bool = True,
-    ) -> tuple[np.ndarray, Any]:
-        return np.full(len(observation), self.action, dtype=np.int64), state
 
 
 def pin_decision(model: BaseAlgorithm, action: int, probability: float) -> float:

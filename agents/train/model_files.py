@@ -15,9 +15,9 @@ from pathlib import Path
 
 from stable_baselines3.common.base_class import BaseAlgorithm
 
-from baselines.policies import ObservationStatistics, normalization_path
-from baselines.self_triggered import DecisionSet
 from etsc_envs.core.files import atomic_write_bytes, interrupts_deferred
+from etsc_envs.decisions import DecisionSet
+from etsc_envs.sb3_models import ObservationStatistics, normalization_path
 
 
 def write_model(
@@ -27,8 +27,8 @@ def write_model(
     statistics_path: Path | None = None,
 ) -> None:
     """Write ``model`` at ``path``, its ``VecNormalize`` statistics (if it has any, as
-    :class:`~baselines.policies.ObservationStatistics` data) at ``statistics_path`` (default:
-    :func:`~baselines.policies.normalization_path`) and its decision set (if any) beside it."""
+    :class:`~etsc_envs.sb3_models.ObservationStatistics` data) at ``statistics_path`` (default:
+    :func:`~etsc_envs.sb3_models.normalization_path`) and its decision set (if any) beside it."""
     with interrupts_deferred():
         if decisions is not None:
             decisions.save(path)

@@ -61,7 +61,6 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, Ve
 import etsc_envs
 from agents.train.config import StartFrom, TrainConfig, load_config
 from agents.train.decision_selection import select_decision
-from agents.train.decisions import make_decision_env
 from agents.train.elapsed_discount import (
     ElapsedRolloutBuffer,
     ElapsedStepsCallback,
@@ -71,14 +70,14 @@ from agents.train.imitation import imitate_decision, imitate_paper_trigger
 from agents.train.model_files import write_model
 from agents.train.validation_callback import PaperComparisonCallback
 from agents.train.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
-from baselines.policies import (
+from etsc_envs.core.files import atomic_write_text
+from etsc_envs.decisions import DecisionSet, decision_set_path, make_decision_env
+from etsc_envs.sb3_models import (
     ENV_ID_ATTRIBUTE,
     ObservationStatistics,
     legacy_normalization_path,
     normalization_path,
 )
-from baselines.self_triggered import DecisionSet, decision_set_path
-from etsc_envs.core.files import atomic_write_text
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"

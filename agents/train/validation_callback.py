@@ -12,7 +12,6 @@ import time
 from pathlib import Path
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
@@ -20,10 +19,10 @@ from agents.train.model_files import write_model
 from baselines.batch import run_batch
 from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
-from baselines.policies import NormalizedModel, ObservationStatistics
-from baselines.self_triggered import DecisionSet, IntervalSchedule, SelfTriggeredPolicy
 from etsc_envs.core.files import atomic_write_text
+from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy
 from etsc_envs.protocol import scenario_set
+from etsc_envs.sb3_models import NormalizedModel, ObservationStatistics
 
 COMPARED_KEYS = ("mean_cost", "transmissions", "transmission_rate", "failure")
 """What a one-episode summary records (the two axes of the comparison and failure)."""
@@ -45,15 +44,15 @@ def set_summary(records: list[dict[str, Any]]) -> dict[str, Any]:
     return summary
 
 
-def deployment(
-    setup: EpisodeSetup, decisions: DecisionSet
-) -> tuple[IntervalSchedule, gym.Space, gym.Space]:
-    """The schedule of ``decisions`` and the transmit/hold spaces a policy of them acts in on
-    the env of ``setup`` (one agent's, for a PettingZoo id): the arguments of
-    :class:`~baselines.self_triggered.SelfTriggeredPolicy` after its model."""
+def deployment(setup: EpisodeSetup, decisions: DecisionSet) -> tuple[Any, ...]:
+    """``decisions`` with the transmit/hold spaces, observation names and sampling period a
+    policy of them acts with on the env of ``setup`` (one agent's, for a PettingZoo id): the
+    arguments of :class:`~etsc_envs.decisions.SelfTriggeredPolicy` after its model."""
     observation_space, action_space, names = setup.policy_spaces()
-    schedule = IntervalSchedule(decisions, observation_space, action_space, names)
-    return schedule, observation_space, action_space
+    env = setup.env
+    loop = env.unwrapped.loop if callable(env.observation_space) else env.unwrapped
+    period = float(loop.params.sampling_period_s)
+    return decisions, observation_space, action_space, names, period
 
 
 class PaperComparisonCallback(BaseCallback):
@@ -74,7 +73,7 @@ class PaperComparisonCallback(BaseCallback):
         best_model_path: where the model with the highest mean validation return so far is
             saved (with its observation statistics beside it), or ``None``.
         decisions: the decision set of a model trained on self-triggered decisions (it is
-            evaluated as :class:`~baselines.self_triggered.SelfTriggeredPolicy` and saved with
+            evaluated as :class:`~etsc_envs.decisions.SelfTriggeredPolicy` and saved with
             the set beside it), or ``None``.
         evaluate_at_start: also evaluate the policy training starts from (timesteps 0), so
             that a run started from a cloned or earlier policy can keep it as its best model
@@ -110,7 +109,7 @@ class PaperComparisonCallback(BaseCallback):
         self.best_return = -np.inf
         self._next_evaluation = every
         self.decisions = decisions
-        self._deployment: tuple[IntervalSchedule, Any, Any] | None = None
+        self._deployment: tuple[Any, ...] | None = None
         self.env_steps = 0
         self._started = time.perf_counter()
         self._earlier_wall_time_s = 0.0

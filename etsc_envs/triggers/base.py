@@ -294,7 +294,7 @@ class HeartbeatPolicy(TriggerPolicy):
     since that channel's last transmission; pass ``episode_start`` (or ``state=None`` at a reset)
     to restart them. Like :class:`PeriodicPolicy`, the heartbeat beats at the episode's first
     instant; always choosing the self-triggered decision "paper × f, heartbeat H"
-    (:mod:`baselines.self_triggered`) takes the same actions.
+    (:mod:`etsc_envs.decisions`) takes the same actions.
     """
 
     def __init__(self, trigger: TriggerPolicy, heartbeat: int) -> None:
@@ -423,7 +423,7 @@ def floored_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]
     floor_s, **keywords)``, ``keywords`` those of ``trigger_class``; one class per rule, so the
     compiled loop compiles each floored rule once. At a reset the time since transmission is
     0, so a floored trigger alone first transmits once the floor has passed; a decision set's
-    floored action transmits at its decision instant (:mod:`baselines.self_triggered`)."""
+    floored action transmits at its decision instant (:mod:`etsc_envs.decisions`)."""
     return _channel_timed_trigger_class(
         trigger_class,
         channel_timed_rule(trigger_class.rule, heartbeat=False),

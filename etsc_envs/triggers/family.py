@@ -63,6 +63,7 @@ MODULATION_BOUND = 3.0
 REFERENCE_S: dict[str, float] = {
     "AttitudeTrackingTrigger": 0.05,
     "InnerFormationTrigger": 0.05,
+    "InnerFormationErrorTimeTrigger": 0.05,
     "OrbitAttitudeTrigger": 0.05,
     "ClusterContainmentTrigger": 0.5,
     "AsteroidOrbitKeepingTrigger": 60.0,

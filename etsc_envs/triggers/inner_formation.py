@@ -109,14 +109,16 @@ def default_error_time_thresholds() -> np.ndarray:
 
 
 @jit
-def inner_formation_error_time_rule(observation, indices, parameters, out):
-    """The error-time rule on one observation: axis i transmits when |r_i(t) - r_i(t_k)| ·
-    (t - t_k) (``sampling_error_m_*`` at ``indices[i]``, ``time_since_transmission_s_*`` at
-    ``indices[3 + i]``) > A_i (``parameters[i]``)."""
+def inner_formation_error_time_condition(observation, indices, parameters, statistic, threshold):
+    """The error-time rule's two sides on one observation: axis i compares |r_i(t) - r_i(t_k)|
+    · (t - t_k) (``sampling_error_m_*`` at ``indices[i]``, ``time_since_transmission_s_*`` at
+    ``indices[3 + i]``) with A_i (``parameters[i]``); it transmits when the product is the
+    larger."""
     for axis in range(3):
         error = abs(float(observation[indices[axis]]))
         elapsed = float(observation[indices[3 + axis]])
-        out[axis] = 1 if error * elapsed > parameters[axis] else 0
+        statistic[axis] = error * elapsed
+        threshold[axis] = parameters[axis]
 
 
 class InnerFormationErrorTimeTrigger(RuleTrigger):
@@ -164,7 +166,15 @@ class InnerFormationErrorTimeTrigger(RuleTrigger):
             keywords={"area1": thresholds[0], "area2": thresholds[1], "area3": thresholds[2]},
         )
 
-    rule = staticmethod(inner_formation_error_time_rule)
+    condition = staticmethod(inner_formation_error_time_condition)
+    strict = True
+    threshold_groups: ClassVar[dict[str, tuple[str, ...]]] = {"area": ("area1", "area2", "area3")}
+
+    @classmethod
+    def paper_thresholds(cls) -> dict[str, float]:
+        """The default areas (:func:`default_error_time_thresholds`; not the paper's own)."""
+        area1, area2, area3 = default_error_time_thresholds()
+        return {"area1": float(area1), "area2": float(area2), "area3": float(area3)}
 
 
 def predicted_sampling_error(velocity_estimate: np.ndarray, hold_s: np.ndarray) -> np.ndarray:

@@ -1,0 +1,128 @@
+"""A model trained on self-triggered decisions, deployed as a transmit/hold policy.
+
+:class:`SelfTriggeredPolicy` takes an already loaded model (anything with an SB3-style
+``predict`` over the decision set's actions) and the decision set; a loader of shipped models
+reads the set beside the model (:meth:`~etsc_envs.decisions.actions.DecisionSet.load`) and
+builds it with :meth:`SelfTriggeredPolicy.for_env`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from etsc_envs.decisions.actions import DecisionSet
+from etsc_envs.decisions.schedule import IntervalSchedule
+from etsc_envs.sb3_models import takes_action_masks
+from etsc_envs.triggers.base import batched_observations
+
+
+class FixedDecision:
+    """One decision, always (SB3's ``predict``): the demonstrator of a decision to clone, the
+    teammates of a learner before they follow its model, and a constant-decision policy."""
+
+    def __init__(self, action: int) -> None:
+        self.action = int(action)
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        return np.full(len(observation), self.action, dtype=np.int64), state
+
+
+class SelfTriggeredPolicy:
+    """A model trained on self-triggered decisions, deployed as a transmit/hold policy.
+
+    ``predict`` follows Stable-Baselines3's convention; its recurrent ``state`` holds each
+    row's ``(action, elapsed)`` (:class:`~etsc_envs.decisions.schedule.IntervalSchedule`). At a
+    row's decision instant (its episode start, or its interval's end) the model picks the next
+    action, masked by the shield if the set has one (``action_masks`` is passed to a model that
+    takes it, such as ``MaskablePPO``; any other model's unsafe choice is replaced).
+
+    Args:
+        model: anything with an SB3-style ``predict`` over the decision set's actions.
+        decisions: the decision set.
+        observation_space, action_space: the transmit/hold env's spaces (one agent's for a
+            PettingZoo id, whose agents the policy then serves as rows).
+        observation_names: its observation names.
+        sampling_period_s: its sampling period (s).
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        decisions: DecisionSet,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        observation_names: tuple[str, ...],
+        sampling_period_s: float,
+    ) -> None:
+        self.model = model
+        self.decisions = decisions
+        self.schedule = IntervalSchedule(
+            decisions, observation_space, action_space, observation_names, sampling_period_s
+        )
+        self.observation_space = observation_space
+        self.action_space = action_space
+
+    @classmethod
+    def for_env(cls, model: Any, decisions: DecisionSet, env: Any) -> SelfTriggeredPolicy:
+        """The policy for ``env``: a Gymnasium env of the suite, or a PettingZoo parallel env
+        (one row of interval state per agent, queried with their observations stacked)."""
+        if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
+            agent = env.possible_agents[0]
+            unwrapped = env.unwrapped
+            return cls(
+                model,
+                decisions,
+                env.observation_space(agent),
+                env.action_space(agent),
+                tuple(unwrapped.agent_observation_names),
+                float(unwrapped.loop.params.sampling_period_s),
+            )
+        unwrapped = env.unwrapped
+        return cls(
+            model,
+            decisions,
+            env.observation_space,
+            env.action_space,
+            tuple(unwrapped.observation_names),
+            float(unwrapped.params.sampling_period_s),
+        )
+
+    def choose(self, obs: np.ndarray, deterministic: bool = True) -> np.ndarray:
+        """The model's (shielded) actions at decision instants with observations ``obs``."""
+        if self.schedule.shield is not None and takes_action_masks(self.model):
+            masks = self.schedule.masks(obs)
+            actions, _ = self.model.predict(obs, deterministic=deterministic, action_masks=masks)
+        else:
+            actions, _ = self.model.predict(obs, deterministic=deterministic)
+        return self.schedule.shielded(actions, obs)
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: np.ndarray | None = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Transmit decision(s) for ``observation``, and the rows' interval state."""
+        obs, single = batched_observations(observation, self.observation_space)
+        if state is None:
+            state, deciding = self.schedule.start(np.zeros(len(obs))), np.ones(len(obs), bool)
+        else:
+            state = np.array(state, dtype=np.int64)
+            deciding = self.schedule.interval_over(obs, state)
+        if episode_start is not None:
+            deciding |= np.asarray(episode_start, dtype=bool).reshape(-1)
+        if deciding.any():
+            state[deciding] = self.schedule.start(self.choose(obs[deciding], deterministic))
+        decision, state = self.schedule.transmit(obs, state)
+        action = decision.astype(np.int64)
+        return (action[0] if single else action), state

@@ -1,0 +1,134 @@
+"""Decision sets as data (:mod:`etsc_envs.decisions.actions`): every shipped version-1 file
+reads into actions with the old labels, round-trips through the version-2 JSON form, and each
+action takes the decisions it took before the sets became data (transmissions and mean cost of
+always taking it, recorded by the version-1 code in ``decision_sets_v1_expected.json``); a
+learned trigger file is a trigger action; bad actions name their field."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import etsc_envs
+from baselines.batch import run_batch
+from etsc_envs.decisions import (
+    DecisionSet,
+    FixedDecision,
+    Hold,
+    SelfTriggeredPolicy,
+    TriggerAction,
+    read_decision_set,
+)
+from etsc_envs.triggers.family import LearnedTrigger
+
+ROOT = Path(__file__).resolve().parent.parent
+EXPECTED = json.loads((Path(__file__).parent / "decision_sets_v1_expected.json").read_text())
+"""Per shipped file: label → [transmissions, mean cost] of always taking the action, seed 11,
+randomized, over :data:`HORIZON_S` (the version-1 code's records)."""
+
+HORIZON_S = {
+    "etsc/AttitudeTracking-v0": 1.0,
+    "etsc/InnerFormation-v0": 1.0,
+    "etsc/OrbitAttitudeTracking-v0": 1.0,
+    "etsc/ClusterContainmentCentral-v0": 20.0,
+    "etsc/ClusterContainment-v0": 20.0,
+    "etsc/AsteroidOrbitKeeping-v0": 1000.0,
+}
+
+
+def _read(name: str) -> DecisionSet:
+    return read_decision_set(json.loads((ROOT / name).read_text()))
+
+
+def _records(decisions: DecisionSet, actions: list[int]) -> dict[str, list]:
+    env_id = decisions.env_id
+    env_args = {"horizon_s": HORIZON_S[env_id], "randomize": True}
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        env = etsc_envs.make_parallel(env_id)
+    else:
+        env = gym.make(env_id)
+    out = {}
+    for action in actions:
+        policy = SelfTriggeredPolicy.for_env(FixedDecision(action), decisions, env)
+        record = run_batch(env_id, policy, [11], env_args)[0]
+        out[decisions.label(action)] = [int(record["transmissions"]), float(record["mean_cost"])]
+    return out
+
+
+def test_every_shipped_set_is_covered():
+    shipped = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "models").glob("*_decisions.json"))
+    assert shipped == sorted(EXPECTED)
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_a_version_1_file_reads_with_its_labels_and_round_trips(name):
+    decisions = _read(name)
+    assert decisions.labels == list(EXPECTED[name])
+    data = json.loads(json.dumps(decisions.to_json()))
+    assert data["format"] == "etsc-envs/decision-set" and data["version"] == 2
+    assert DecisionSet.from_json(data) == decisions
+    assert read_decision_set(data) == decisions
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_a_shipped_sets_last_trigger_and_longest_hold_take_the_old_decisions(name):
+    decisions = _read(name)
+    chosen = [decisions.hold_indices[-1], decisions.trigger_indices[-1]]
+    expected = {decisions.label(a): EXPECTED[name][decisions.label(a)] for a in chosen}
+    assert _records(decisions, chosen) == expected
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_every_action_of_a_shipped_set_takes_the_old_decisions(name):
+    decisions = _read(name)
+    assert _records(decisions, list(range(decisions.n_actions))) == EXPECTED[name]
+
+
+def test_a_learned_trigger_file_is_a_trigger_action():
+    """Always choosing the action of ``models/AttitudeTracking-v0_learned.json`` (not sent
+    first, no cap) transmits where the learned trigger alone does."""
+    learned = LearnedTrigger.load(ROOT / "models" / "AttitudeTracking-v0_learned.json")
+    action = TriggerAction.from_learned(learned)
+    decisions = DecisionSet(learned.env_id, (Hold(1), action))
+    assert DecisionSet.from_json(json.loads(json.dumps(decisions.to_json()))) == decisions
+    env = gym.make(learned.env_id, horizon_s=2.0, randomize=True)
+    alone = learned.policy_for(env)
+    deployed = SelfTriggeredPolicy.for_env(FixedDecision(1), decisions, env)
+    obs, _ = env.reset(seed=4)
+    state, sent, done = None, 0, False
+    while not done:
+        action_bit, state = deployed.predict(obs, state)
+        assert np.array_equal(action_bit, alone.predict(obs)[0])
+        sent += int(np.sum(action_bit))
+        obs, _, terminated, truncated, _ = env.step(action_bit)
+        done = terminated or truncated
+    assert sent > 0
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ({"kind": "hold", "instants": 0}, "hold instants must be an integer in 1"),
+        ({"kind": "hold"}, "missing"),
+        ({"kind": "sometimes"}, "kind must be one of"),
+        ({"kind": "trigger", "cap": 2.5}, "cap must be an integer"),
+        ({"kind": "trigger", "send_first": "yes"}, "send_first must be true or false"),
+        ({"kind": "trigger", "rule": "clock"}, "rule must be one of"),
+        ({"kind": "trigger", "point": {"factors": {"pi": 2.0}}}, "allowed"),
+        ({"kind": "trigger", "keywords": {"psi": 1.0}}, "keywords"),
+    ],
+)
+def test_a_bad_action_names_its_field(data, message):
+    block = {"actions": [{"kind": "hold", "instants": 1}, data]}
+    with pytest.raises(ValueError, match=message):
+        read_decision_set(block, "etsc/AttitudeTracking-v0")
+
+
+def test_a_set_refuses_a_shield_where_there_is_none():
+    with pytest.raises(ValueError, match="shield_multiple: no shield"):
+        DecisionSet("etsc/AttitudeTracking-v0", (Hold(1),), shield_multiple=2.0)
