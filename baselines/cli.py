@@ -19,9 +19,8 @@ from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.paper import RULE_NAMES
 from etsc_envs.core.validation import require_int_at_least
-from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy, decision_set_path
 from etsc_envs.papers import ids_with_rule, paper_of, rule_of
-from etsc_envs.sb3_models import load_sb3
+from etsc_envs.sb3_models import sb3_policy
 from etsc_envs.triggers import AlwaysPolicy, PeriodicPolicy, SwitchedPeriodicPolicy
 from etsc_envs.triggers.base import (
     ClockTrigger,
@@ -299,33 +298,13 @@ def _policy_for(
     if spec.startswith("sb3:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")
-        path = spec.removeprefix("sb3:")
-        if decision_set_path(path).is_file():
-            decisions = DecisionSet.load(path)
-            if decisions.env_id != env_id:
-                raise ValueError(
-                    f"sb3 model {path} takes self-triggered decisions in {decisions.env_id}, "
-                    f"not in {env_id}"
-                )
-            model = load_sb3(
-                path,
-                observation_space=observation_space,
-                action_space=decisions.action_space,
-                env_id=f"{env_id} (self-triggered, {decisions.n_actions} actions)",
-            )
-            return SelfTriggeredPolicy(
-                model,
-                decisions,
-                observation_space,
-                action_space,
-                observation_names(),
-                loop().sampling_period_s,
-            )
-        return load_sb3(
-            path,
-            observation_space=observation_space,
-            action_space=action_space,
-            env_id=env_id,
+        return sb3_policy(
+            spec.removeprefix("sb3:"),
+            observation_space,
+            action_space,
+            tuple(observation_names()),
+            loop().sampling_period_s,
+            env_id,
         )
     raise ValueError(f"--policy must be one of {POLICY_CHOICES}, got {spec!r}")
 

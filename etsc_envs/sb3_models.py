@@ -591,17 +591,69 @@ def env_id_of(env: Any) -> str:
     )
 
 
+def sb3_policy(
+    path: str | Path,
+    observation_space: gym.Space,
+    action_space: gym.Space,
+    observation_names: tuple[str, ...],
+    sampling_period_s: float,
+    env_id: str,
+) -> Any:
+    """The Stable-Baselines3 model saved at ``path`` as a transmit/hold policy for an env of
+    ``env_id`` with these spaces, observation names and sampling period (one agent's, for a
+    PettingZoo id).
+
+    A model with a decision set beside it (``NAME_decisions.json``,
+    :func:`~etsc_envs.decisions.decision_set_path`) took self-triggered decisions: it is loaded
+    for the set's actions and deployed as a
+    :class:`~etsc_envs.decisions.SelfTriggeredPolicy`; ``ValueError`` if the set was made
+    for another id. Any other model is :func:`load_sb3` for the env's spaces."""
+    from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy, decision_set_path
+
+    if not decision_set_path(path).is_file():
+        return load_sb3(
+            path, observation_space=observation_space, action_space=action_space, env_id=env_id
+        )
+    decisions = DecisionSet.load(path)
+    if decisions.env_id != env_id:
+        raise ValueError(
+            f"sb3 model {path} takes self-triggered decisions in {decisions.env_id}, "
+            f"not in {env_id}"
+        )
+    model = load_sb3(
+        path,
+        observation_space=observation_space,
+        action_space=decisions.action_space,
+        env_id=f"{env_id} (self-triggered, {decisions.n_actions} actions)",
+    )
+    return SelfTriggeredPolicy(
+        model, decisions, observation_space, action_space, observation_names, sampling_period_s
+    )
+
+
 def load_sb3_policy(path: str | Path, env: Any) -> Any:
     """The Stable-Baselines3 model saved at ``path`` as a trigger policy for ``env`` (a
     Gymnasium env of this package, or a PettingZoo parallel env, whose agents then share it,
-    queried with their observations stacked): :func:`load_sb3` with the env's spaces, its
-    statistics beside it. ``ValueError`` naming the model and both envs when it was trained
-    for other spaces."""
+    queried with their observations stacked): :func:`sb3_policy` with the env's spaces,
+    observation names, sampling period and id (:func:`env_id_of`). ``ValueError`` naming the
+    model and both envs when it was trained for other spaces."""
     env_id = env_id_of(env)
-    observation_space, action_space = env.observation_space, env.action_space
-    if callable(getattr(env, "observation_space", None)):  # PettingZoo: one agent's spaces
+    unwrapped = env.unwrapped
+    if callable(getattr(env, "observation_space", None)):  # PettingZoo: one agent's view
         agent = env.possible_agents[0]
-        observation_space, action_space = env.observation_space(agent), env.action_space(agent)
-    return load_sb3(
-        path, observation_space=observation_space, action_space=action_space, env_id=env_id
+        return sb3_policy(
+            path,
+            env.observation_space(agent),
+            env.action_space(agent),
+            tuple(unwrapped.agent_observation_names),
+            float(unwrapped.loop.sampling_period_s),
+            env_id,
+        )
+    return sb3_policy(
+        path,
+        env.observation_space,
+        env.action_space,
+        tuple(unwrapped.observation_names),
+        float(unwrapped.sampling_period_s),
+        env_id,
     )
