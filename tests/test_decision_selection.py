@@ -22,6 +22,7 @@ from baselines.cli import episode_setup
 from etsc_envs.decisions import FixedDecision, SelfTriggeredPolicy, decision_set_v1
 from etsc_envs.protocol import scenario_set
 from etsc_envs.triggers.base import RuleTrigger
+from tests.v1_decisions import v1_block
 
 ATTITUDE = "etsc/AttitudeTracking-v0"
 CANDIDATES = ["hold 1", "hold 4", "paper x1", "paper x4"]
@@ -113,7 +114,7 @@ BASE_CONFIG = {
     "algorithm": "PPO",
     "policy": "MlpPolicy",
     "total_timesteps": 32,
-    "decisions": {"max_exponent": 3, "factors": [1.0, 4.0]},
+    "decisions": v1_block(ATTITUDE, max_exponent=3, factors=[1.0, 4.0]),
 }
 
 

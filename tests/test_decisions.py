@@ -22,7 +22,7 @@ from etsc_envs.sb3_models import load_sb3, takes_action_masks
 from etsc_envs.triggers import PeriodicPolicy
 from etsc_envs.triggers.asteroid import AsteroidShield
 from etsc_envs.triggers.inner_formation import InnerFormationShield, default_error_time_thresholds
-from tests.v1_decisions import caps_of, deployed_policy, factors_of, v1_wrapper
+from tests.v1_decisions import caps_of, deployed_policy, factors_of, v1_block, v1_wrapper
 
 ATTITUDE = "etsc/AttitudeTracking-v0"
 FORMATION = "etsc/InnerFormation-v0"
@@ -404,7 +404,7 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         "hyperparameters": {"n_steps": 32, "batch_size": 32, "n_epochs": 1, "gamma": 0.999},
         "total_timesteps": 64,
         "out_dir": str(out_dir),
-        "decisions": {"max_exponent": 3, "shield_multiple": 2.0},
+        "decisions": v1_block(FORMATION, max_exponent=3, shield_multiple=2.0),
         "evaluation_every": 32,
         "evaluation_scenarios": 2,
         "evaluation_env_kwargs": {"horizon_s": 0.1},
@@ -425,21 +425,40 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
     assert result["episodes"][0]["transmissions"] > 0
 
 
+HOLD_1 = {"actions": [{"kind": "hold", "instants": 1}]}
+"""A config's decisions block of one action, "hold 1"."""
+ERROR_TIME = {"kind": "trigger", "rule": "error_time"}
+"""The error-time rule's action (paper 004's rule only)."""
+
+
 @pytest.mark.parametrize(
     ("changes", "message"),
     [
         ({"algorithm": "MaskablePPO"}, "MaskablePPO needs the key 'decisions'"),
-        ({"decisions": {"max_exponent": 3, "holds": 2}}, "'decisions'"),
-        ({"decisions": {"shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
-        ({"decisions": {"rule": "error_time"}, "env_id": ATTITUDE}, "no error_time rule"),
-        ({"decisions": {"rule_keywords": {"b1": 1.0}}}, "config key 'decisions': rule_keywords"),
-        ({"decisions": {}, "start_from": {"steps": 64}}, "'start_from.decision' is required"),
         (
-            {"decisions": {}, "start_from": {"decision": "hold 1"}},
+            {"decisions": {"max_exponent": 3, "factors": [1.0]}},
+            r"'decisions' must be the decision set's own form .* \['factors', 'max_exponent'\]",
+        ),
+        (
+            {"decisions": {"actions": [{"kind": "hold", "instants": 0}]}},
+            r"config key 'decisions': actions\[0\]: hold instants must be an integer",
+        ),
+        ({"decisions": {**HOLD_1, "shield_multiple": 2.0}, "env_id": ATTITUDE}, "shield_multiple"),
+        (
+            {"decisions": {"actions": [ERROR_TIME]}, "env_id": ATTITUDE},
+            r"actions\[0\]: env_id must be one of .* for rule 'error_time'",
+        ),
+        (
+            {"decisions": {"actions": [{"kind": "trigger", "keywords": {"b1": 1.0}}]}},
+            r"config key 'decisions': actions\[0\]: keywords: \['b1'\] are not keywords",
+        ),
+        ({"decisions": HOLD_1, "start_from": {"steps": 64}}, "'start_from.decision' is required"),
+        (
+            {"decisions": HOLD_1, "start_from": {"decision": "hold 1"}},
             r"missing config 'start_from' key\(s\) \['steps'\]",
         ),
         (
-            {"decisions": {}, "start_from": {"steps": 8, "decision": "hold 1", "epoch": 3}},
+            {"decisions": HOLD_1, "start_from": {"steps": 8, "decision": "hold 1", "epoch": 3}},
             r"unknown config 'start_from' key\(s\) \['epoch'\]",
         ),
         (
@@ -452,13 +471,16 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
         ),
         (
             {
-                "decisions": {},
+                "decisions": HOLD_1,
                 "start_from": {"steps": 8, "decision": "hold 1", "pinned_probability": 1.0},
             },
             r"'start_from.pinned_probability' must be a number in \(0, 1\)",
         ),
         (
-            {"decisions": {"max_exponent": 3}, "start_from": {"steps": 8, "decision": "hold 64"}},
+            {
+                "decisions": v1_block(FORMATION, max_exponent=3),
+                "start_from": {"steps": 8, "decision": "hold 64"},
+            },
             r"'start_from.decision': 'hold 64' is not a decision of this set",
         ),
         ({"imitation_steps": 8}, r"unknown config key\(s\) \['imitation_steps'\]"),
@@ -482,7 +504,7 @@ def test_training_config_checks_the_decisions(tmp_path, changes, message):
 VALIDATED_FORMATION_RUN = {
     "env_id": FORMATION,
     "env_kwargs": {"horizon_s": 0.2},
-    "decisions": {"max_exponent": 3},
+    "decisions": v1_block(FORMATION, max_exponent=3),
     "evaluation_every": 32,
     "evaluation_scenarios": 2,
     "evaluation_env_kwargs": {"horizon_s": 0.1},
@@ -534,14 +556,16 @@ def test_cloning_a_decision_makes_the_policy_take_it(tmp_path):
 
 
 def test_the_rule_with_a_heartbeat_trains_pinned_and_deploys(tmp_path):
-    """A short run pinned to "paper x8, heartbeat 12" (``rule_cap`` and ``rule_heartbeat``)
+    """A short run pinned to "paper x8, heartbeat 12" (a cap of 12 instants, sent first)
     completes, records the decision, and its saved model deploys through ``sb3:`` with the
     heartbeat in its decision set."""
     out_dir, summary = train_cloned(
         tmp_path,
         env_id=ATTITUDE,
         env_kwargs={"horizon_s": 0.3},
-        decisions={"max_exponent": 3, "factors": [8.0], "rule_cap": 12, "rule_heartbeat": True},
+        decisions=v1_block(
+            ATTITUDE, max_exponent=3, factors=[8.0], rule_cap=12, rule_heartbeat=True
+        ),
         start_from={
             "steps": 128,
             "epochs": 30,
@@ -565,7 +589,7 @@ def test_the_error_time_rule_trains_pinned_and_deploys(tmp_path):
         tmp_path,
         env_id=FORMATION,
         env_kwargs={"horizon_s": 0.3},
-        decisions={"max_exponent": 3, "rule": "error_time", "factors": [1.0, 2.0]},
+        decisions=v1_block(FORMATION, max_exponent=3, rule="error_time", factors=[1.0, 2.0]),
         start_from={
             "steps": 128,
             "epochs": 30,
@@ -653,7 +677,7 @@ def test_the_decentralised_cluster_trains_pinned_and_deploys(tmp_path):
         tmp_path,
         env_id=cluster,
         env_kwargs={"horizon_s": 2.0},
-        decisions={"max_exponent": 4, "factors": [1.0, 1.5]},
+        decisions=v1_block(cluster, max_exponent=4, factors=[1.0, 1.5]),
         start_from={"steps": 64, "epochs": 5, "decision": "paper x1.5", "pinned_probability": 0.9},
     )
     assert summary["imitation"]["decision"] == "paper x1.5, pinned at probability 0.9"

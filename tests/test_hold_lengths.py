@@ -54,7 +54,8 @@ def test_the_holds_survive_a_save_a_load_and_a_config(tmp_path):
     decisions.save(tmp_path / "model.zip")
     assert DecisionSet.load(tmp_path / "model.zip") == decisions
     config = {**BASE_CONFIG, "out_dir": str(tmp_path / "run")}
-    config["decisions"] = {"holds": list(HOLDS), "factors": [1.0]}
+    holds = [{"kind": "hold", "instants": instants} for instants in HOLDS]
+    config["decisions"] = {"actions": [*holds, {"kind": "trigger", "cap": HOLDS[-1]}]}
     config = config_from_dict(config)
     assert [action["instants"] for action in config.decisions["actions"][:4]] == list(HOLDS)
 

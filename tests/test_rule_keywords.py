@@ -27,7 +27,7 @@ from tests.test_rule_floor import (
     ObservationLog,
     floored,
 )
-from tests.v1_decisions import v1_wrapper
+from tests.v1_decisions import v1_block, v1_wrapper
 
 RELATIVE = {"a1": 2.4, "a2": 3.2}
 """Eq. (21)'s a1, a2 at four times the paper's (Theorem 2 needs a1 < 3.2, a2 < 3.6)."""
@@ -120,7 +120,7 @@ def test_a_keyword_outside_the_triggers_range_names_the_keywords():
 
 def test_a_training_config_takes_the_keywords(tmp_path):
     """(Bad keywords in a config: ``tests/test_decisions.py``.)"""
-    decisions = {"factors": [4.0], "rule_floor": 8, "rule_keywords": RELATIVE}
+    decisions = v1_block(ORBIT, factors=[4.0], rule_floor=8, rule_keywords=RELATIVE)
     config = {**BASE_CONFIG, "env_id": ORBIT, "env_kwargs": {"horizon_s": 0.05}}
     config.update(out_dir=str(tmp_path / "run"), decisions=decisions)
     decisions = read_decision_set(config_from_dict(config).decisions)

@@ -1,6 +1,7 @@
 """Decision sets written in version 1's keywords (``max_exponent``, ``factors``, ``rule_cap``,
 ``rule_heartbeat``, ``rule_floor``, ...), read through :func:`etsc_envs.decisions.decision_set_v1`
-into the wrappers that take a set: the tests of those keywords' decisions keep their form."""
+into the wrappers that take a set, and into a training config's ``decisions:`` block: the tests of
+those keywords' decisions keep their form."""
 
 from __future__ import annotations
 
@@ -37,6 +38,13 @@ def v1_follower(
         gamma=gamma,
         teammate_decision=teammate_decision,
     )
+
+
+def v1_block(env_id: str, **keywords: Any) -> dict[str, Any]:
+    """A training config's ``decisions:`` block, the set's own form, of the set of version-1
+    ``keywords`` for ``env_id``."""
+    data = decision_set_v1(env_id, **keywords).to_json()
+    return {"shield_multiple": data["shield_multiple"], "actions": data["actions"]}
 
 
 def deployed_policy(model: Any, source: Any, env: Any) -> SelfTriggeredPolicy:

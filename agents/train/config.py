@@ -72,8 +72,9 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   decision set's own JSON form (:mod:`etsc_envs.decisions.actions`: ``shield_multiple`` and
   ``actions``, a list of ``{kind: hold, instants: N}`` and ``{kind: trigger, point: {...},
-  cap: N, send_first: ...}``; ``env_id`` is the config's; a version-1 block of keywords is
-  read as :func:`~etsc_envs.decisions.actions.read_v1` says), trained through
+  cap: N, send_first: ...}``; ``env_id`` is the config's; version 1's keywords, which
+  :func:`~etsc_envs.decisions.actions.read_v1` reads from a model's version-1 decision file,
+  are refused here), trained through
   :class:`etsc_envs.decisions.SelfTriggeredWrapper` (its ``gamma`` is
   ``hyperparameters.gamma``) on a ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
   :class:`etsc_envs.decisions.FollowerDecisionEnv`; cloning with
@@ -109,7 +110,7 @@ import etsc_envs
 from agents.train.decision_selection import BEST_DECISION
 from baselines.cli import require_env_id
 from etsc_envs.core.files import require_writable_folder
-from etsc_envs.decisions import DecisionSet, make_decision_env, read_decision_set
+from etsc_envs.decisions import DecisionSet, make_decision_env
 from etsc_envs.protocol import require_training_seeds
 from etsc_envs.sb3_models import require_model_fits
 
@@ -415,9 +416,9 @@ def _check_decisions(
     env_kwargs: dict[str, Any],
     start_from: StartFrom | None,
 ) -> dict[str, Any] | None:
-    """``values["decisions"]`` (null, or a decision set's JSON form for ``env_id``:
-    :func:`~etsc_envs.decisions.read_decision_set`) as the set's version-2 JSON form, which
-    ``start_from`` fits (:meth:`StartFrom.require_fits`)."""
+    """``values["decisions"]`` (null, or a decision set's version-2 JSON form for ``env_id``:
+    :meth:`~etsc_envs.decisions.DecisionSet.from_json`) as that form, which ``start_from`` fits
+    (:meth:`StartFrom.require_fits`)."""
     if values["decisions"] is None:
         if algorithm == "MaskablePPO":
             raise ValueError("config key 'algorithm': MaskablePPO needs the key 'decisions'")
@@ -425,8 +426,15 @@ def _check_decisions(
             start_from.require_fits(None)
         return None
     block = _check_mapping("decisions", values["decisions"])
+    if "actions" not in block:
+        raise ValueError(
+            f"config key 'decisions' must be the decision set's own form {{shield_multiple: ..., "
+            f"actions: [{{kind: hold, instants: N}}, {{kind: trigger, point: {{...}}, cap: N, "
+            f"send_first: ...}}, ...]}}, got the keys {sorted(block)} (version 1's keywords: "
+            f"etsc_envs.decisions.read_decision_set converts them)"
+        )
     try:
-        decisions = read_decision_set(block, env_id)
+        decisions = DecisionSet.from_json(block, env_id)
         wrapper = make_decision_env(env_id, env_kwargs, decisions)
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
