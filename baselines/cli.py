@@ -19,8 +19,8 @@ from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.paper import RULE_NAMES
 from etsc_envs.core.validation import require_int_at_least
+from etsc_envs.decisions.policy import sb3_policy
 from etsc_envs.papers import ids_with_rule, paper_of, rule_of
-from etsc_envs.sb3_models import sb3_policy
 from etsc_envs.triggers import AlwaysPolicy, PeriodicPolicy, SwitchedPeriodicPolicy
 from etsc_envs.triggers.base import (
     ClockTrigger,

@@ -26,7 +26,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-import etsc_envs
+from etsc_envs import registry
 
 ENV_ID_ATTRIBUTE = "etsc_env_id"
 """The attribute a model trained by :mod:`agents.train` carries, saved in its zip's ``data``
@@ -287,15 +287,15 @@ def _ids_fitting(observation_space: gym.Space, action_space: gym.Space) -> str:
     """For a model that does not record its env id: the etsc-envs ids whose default spaces it
     fits (found by building each env once; only on the way to an error message)."""
     fitting = []
-    for env_id in sorted(etsc_envs.ENV_IDS):
+    for env_id in sorted(registry.ENV_IDS):
         env = gym.make(env_id)
         if _same_layout(observation_space, env.observation_space) and _same_layout(
             action_space, env.action_space
         ):
             fitting.append(env_id)
         env.close()
-    for env_id in sorted(etsc_envs.PETTINGZOO_ENV_IDS):
-        env = etsc_envs.make_parallel(env_id)
+    for env_id in sorted(registry.PETTINGZOO_ENV_IDS):
+        env = registry.make_parallel(env_id)
         agent = env.possible_agents[0]
         if _same_layout(observation_space, env.observation_space(agent)) and _same_layout(
             action_space, env.action_space(agent)
@@ -574,86 +574,18 @@ def env_id_of(env: Any) -> str:
     ``ValueError`` for any other env."""
     if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
         name = env.metadata.get("name")
-        for env_id, module in etsc_envs.PETTINGZOO_ENV_IDS.items():
+        for env_id, module in registry.PETTINGZOO_ENV_IDS.items():
             if module.rpartition(".")[2] == name:
                 return env_id
     else:
         spec = getattr(env, "spec", None)
-        if spec is not None and spec.id in etsc_envs.ENV_IDS:
+        if spec is not None and spec.id in registry.ENV_IDS:
             return spec.id
         unwrapped = type(env.unwrapped)
-        for env_id, entry_point in etsc_envs.ENV_IDS.items():
+        for env_id, entry_point in registry.ENV_IDS.items():
             if entry_point == f"{unwrapped.__module__}:{unwrapped.__qualname__}":
                 return env_id
     raise ValueError(
-        f"env: {env!r} is not an env of etsc-envs (a Gymnasium env of {sorted(etsc_envs.ENV_IDS)} "
-        f"or a PettingZoo parallel env of {sorted(etsc_envs.PETTINGZOO_ENV_IDS)})"
-    )
-
-
-def sb3_policy(
-    path: str | Path,
-    observation_space: gym.Space,
-    action_space: gym.Space,
-    observation_names: tuple[str, ...],
-    sampling_period_s: float,
-    env_id: str,
-) -> Any:
-    """The Stable-Baselines3 model saved at ``path`` as a transmit/hold policy for an env of
-    ``env_id`` with these spaces, observation names and sampling period (one agent's, for a
-    PettingZoo id).
-
-    A model with a decision set beside it (``NAME_decisions.json``,
-    :func:`~etsc_envs.decisions.decision_set_path`) took self-triggered decisions: it is loaded
-    for the set's actions and deployed as a
-    :class:`~etsc_envs.decisions.SelfTriggeredPolicy`; ``ValueError`` if the set was made
-    for another id. Any other model is :func:`load_sb3` for the env's spaces."""
-    from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy, decision_set_path
-
-    if not decision_set_path(path).is_file():
-        return load_sb3(
-            path, observation_space=observation_space, action_space=action_space, env_id=env_id
-        )
-    decisions = DecisionSet.load(path)
-    if decisions.env_id != env_id:
-        raise ValueError(
-            f"sb3 model {path} takes self-triggered decisions in {decisions.env_id}, "
-            f"not in {env_id}"
-        )
-    model = load_sb3(
-        path,
-        observation_space=observation_space,
-        action_space=decisions.action_space,
-        env_id=f"{env_id} (self-triggered, {decisions.n_actions} actions)",
-    )
-    return SelfTriggeredPolicy(
-        model, decisions, observation_space, action_space, observation_names, sampling_period_s
-    )
-
-
-def load_sb3_policy(path: str | Path, env: Any) -> Any:
-    """The Stable-Baselines3 model saved at ``path`` as a trigger policy for ``env`` (a
-    Gymnasium env of this package, or a PettingZoo parallel env, whose agents then share it,
-    queried with their observations stacked): :func:`sb3_policy` with the env's spaces,
-    observation names, sampling period and id (:func:`env_id_of`). ``ValueError`` naming the
-    model and both envs when it was trained for other spaces."""
-    env_id = env_id_of(env)
-    unwrapped = env.unwrapped
-    if callable(getattr(env, "observation_space", None)):  # PettingZoo: one agent's view
-        agent = env.possible_agents[0]
-        return sb3_policy(
-            path,
-            env.observation_space(agent),
-            env.action_space(agent),
-            tuple(unwrapped.agent_observation_names),
-            float(unwrapped.loop.sampling_period_s),
-            env_id,
-        )
-    return sb3_policy(
-        path,
-        env.observation_space,
-        env.action_space,
-        tuple(unwrapped.observation_names),
-        float(unwrapped.sampling_period_s),
-        env_id,
+        f"env: {env!r} is not an env of etsc-envs (a Gymnasium env of {sorted(registry.ENV_IDS)} "
+        f"or a PettingZoo parallel env of {sorted(registry.PETTINGZOO_ENV_IDS)})"
     )

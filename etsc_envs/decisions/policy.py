@@ -8,14 +8,15 @@ builds it with :meth:`SelfTriggeredPolicy.for_env`.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
-from etsc_envs.decisions.actions import DecisionSet
+from etsc_envs.decisions.actions import DecisionSet, decision_set_path
 from etsc_envs.decisions.schedule import IntervalSchedule
-from etsc_envs.sb3_models import takes_action_masks
+from etsc_envs.sb3_models import env_id_of, load_sb3, takes_action_masks
 from etsc_envs.triggers.base import batched_observations
 
 
@@ -126,3 +127,70 @@ class SelfTriggeredPolicy:
         decision, state = self.schedule.transmit(obs, state)
         action = decision.astype(np.int64)
         return (action[0] if single else action), state
+
+
+def sb3_policy(
+    path: str | Path,
+    observation_space: gym.Space,
+    action_space: gym.Space,
+    observation_names: tuple[str, ...],
+    sampling_period_s: float,
+    env_id: str,
+) -> Any:
+    """The Stable-Baselines3 model saved at ``path`` as a transmit/hold policy for an env of
+    ``env_id`` with these spaces, observation names and sampling period (one agent's, for a
+    PettingZoo id).
+
+    A model with a decision set beside it (``NAME_decisions.json``,
+    :func:`~etsc_envs.decisions.decision_set_path`) took self-triggered decisions: it is loaded
+    for the set's actions and deployed as a
+    :class:`~etsc_envs.decisions.SelfTriggeredPolicy`; ``ValueError`` if the set was made
+    for another id. Any other model is :func:`~etsc_envs.sb3_models.load_sb3` for the env's
+    spaces."""
+    if not decision_set_path(path).is_file():
+        return load_sb3(
+            path, observation_space=observation_space, action_space=action_space, env_id=env_id
+        )
+    decisions = DecisionSet.load(path)
+    if decisions.env_id != env_id:
+        raise ValueError(
+            f"sb3 model {path} takes self-triggered decisions in {decisions.env_id}, "
+            f"not in {env_id}"
+        )
+    model = load_sb3(
+        path,
+        observation_space=observation_space,
+        action_space=decisions.action_space,
+        env_id=f"{env_id} (self-triggered, {decisions.n_actions} actions)",
+    )
+    return SelfTriggeredPolicy(
+        model, decisions, observation_space, action_space, observation_names, sampling_period_s
+    )
+
+
+def load_sb3_policy(path: str | Path, env: Any) -> Any:
+    """The Stable-Baselines3 model saved at ``path`` as a trigger policy for ``env`` (a
+    Gymnasium env of this package, or a PettingZoo parallel env, whose agents then share it,
+    queried with their observations stacked): :func:`sb3_policy` with the env's spaces,
+    observation names, sampling period and id (:func:`~etsc_envs.sb3_models.env_id_of`).
+    ``ValueError`` naming the model and both envs when it was trained for other spaces."""
+    env_id = env_id_of(env)
+    unwrapped = env.unwrapped
+    if callable(getattr(env, "observation_space", None)):  # PettingZoo: one agent's view
+        agent = env.possible_agents[0]
+        return sb3_policy(
+            path,
+            env.observation_space(agent),
+            env.action_space(agent),
+            tuple(unwrapped.agent_observation_names),
+            float(unwrapped.loop.sampling_period_s),
+            env_id,
+        )
+    return sb3_policy(
+        path,
+        env.observation_space,
+        env.action_space,
+        tuple(unwrapped.observation_names),
+        float(unwrapped.sampling_period_s),
+        env_id,
+    )

@@ -43,7 +43,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import OrderEnforcing, PassiveEnvChecker
 
-import etsc_envs
+from etsc_envs import registry
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.validation import require_discount
@@ -214,15 +214,15 @@ class FollowerDecisionEnv(gym.Env):
         gamma: float = 0.99,
         teammate_decision: str | None = None,
     ) -> None:
-        if env_id not in etsc_envs.PETTINGZOO_ENV_IDS:
+        if env_id not in registry.PETTINGZOO_ENV_IDS:
             raise ValueError(
                 f"env_id: {env_id!r} is not a PettingZoo id; known: "
-                f"{sorted(etsc_envs.PETTINGZOO_ENV_IDS)}"
+                f"{sorted(registry.PETTINGZOO_ENV_IDS)}"
             )
         if not isinstance(decisions, DecisionSet) or decisions.env_id != env_id:
             raise ValueError(f"decisions must be a DecisionSet for {env_id}, got {decisions!r}")
         self.gamma = require_discount("gamma", gamma)
-        self.parallel_env = etsc_envs.make_parallel(env_id, **(env_kwargs or {}))
+        self.parallel_env = registry.make_parallel(env_id, **(env_kwargs or {}))
         self.loop = cast(Any, self.parallel_env.unwrapped).loop
         self.agent_index = agent_observation_index(self.loop)
         self.decisions = decisions
@@ -334,7 +334,7 @@ def make_decision_env(
     (:func:`~etsc_envs.decisions.actions.read_decision_set`)."""
     if not isinstance(decisions, DecisionSet):
         decisions = read_decision_set(decisions, env_id)
-    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+    if env_id in registry.PETTINGZOO_ENV_IDS:
         return FollowerDecisionEnv(
             env_id, decisions, env_kwargs, gamma=gamma, teammate_decision=teammate_decision
         )
