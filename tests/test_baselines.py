@@ -37,9 +37,9 @@ from baselines import reproduce
 from baselines.cli import parse_assignments
 from baselines.episodes import run_episode, to_jsonable
 from baselines.evaluate import evaluate
-from baselines.policies import infer_sb3_algorithm, load_sb3
 from baselines.reproductions.report import Scenario, claim, metric_row, render, stages
 from etsc_envs.papers import paper_of
+from etsc_envs.sb3_models import infer_sb3_algorithm, load_sb3
 from etsc_envs.triggers import (
     AlwaysPolicy,
     AttitudeTrackingTrigger,

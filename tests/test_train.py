@@ -136,7 +136,7 @@ def test_every_shipped_config_trains_saves_reloads_and_evaluates(
     config_path: Path, tmp_path: Path
 ) -> None:
     from baselines.evaluate import main as evaluate_main
-    from baselines.policies import NormalizedModel, load_sb3, normalization_path
+    from etsc_envs.sb3_models import NormalizedModel, load_sb3, normalization_path
 
     out_dir = tmp_path / "run"
     config = tiny_config(out_dir, config_path) | {
@@ -195,7 +195,7 @@ def test_init_from_starts_from_an_earlier_models_weights_and_statistics(
 ) -> None:
     import numpy as np
 
-    from baselines.policies import ObservationStatistics, normalization_path
+    from etsc_envs.sb3_models import ObservationStatistics, normalization_path
 
     first = tmp_path / "first"
     assert main(["--config", str(write_config(tiny_config(first), tmp_path))]) == 0
