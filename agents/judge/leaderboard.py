@@ -51,7 +51,7 @@ from baselines.plotting import save
 from baselines.statistics import paired_ratio, seeds_summary, summarize
 from etsc_envs.core.files import atomic_write_text
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 RECORDS = ROOT / "docs" / "results"
 OUTPUT = ROOT / "docs" / "leaderboard.md"
 SETS = ("test", "paper")
