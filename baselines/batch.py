@@ -96,7 +96,7 @@ def run_batch(
     Args:
         env_id: a Gymnasium or PettingZoo id of the suite.
         policy: anything with an SB3-style batched ``predict`` (for a PettingZoo id, one policy
-            for every agent, as :func:`baselines.cli.make_agent_policy` builds).
+            for every agent, as :func:`baselines.policy_specs.make_agent_policy` builds).
         seeds: the reset seed of each scenario.
         env_args: keywords of every scenario's env.
         progress: show a progress bar over the sampling instants.
@@ -147,7 +147,8 @@ def _run_part(
 ) -> list[dict[str, Any]]:
     """One worker's share of :func:`run_batch_in_processes`, on ``core`` alone (so that its
     vector env steps with one thread and PyTorch with one)."""
-    from baselines.cli import episode_setup, limit_torch_threads
+    from baselines.cli import limit_torch_threads
+    from baselines.policy_specs import episode_setup
 
     env_id, policy_spec, policy_args, env_args, description = work
     if hasattr(os, "sched_setaffinity"):

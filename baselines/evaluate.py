@@ -33,15 +33,10 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.batch import process_count, run_batch, run_batch_in_processes
-from baselines.cli import (
-    POLICY_CHOICES,
-    episode_setup,
-    limit_torch_threads,
-    parse_assignments,
-    write_json,
-)
+from baselines.cli import limit_torch_threads, parse_assignments, write_json
 from baselines.episodes import mean_record, window_edges
 from baselines.plotting import plot_episode
+from baselines.policy_specs import POLICY_CHOICES, episode_setup
 from baselines.statistics import aggregate_lines, aggregate_records
 from etsc_envs.core.files import output_file_argument, output_folder_argument
 from etsc_envs.protocol import DEFAULT_SET_SIZE, SCENARIO_SET_NAMES, scenario_set

@@ -13,7 +13,7 @@ import pytest
 
 from agents.train.validation_callback import deployment
 from baselines.batch import run_batch, run_batch_in_processes
-from baselines.cli import episode_setup
+from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import SelfTriggeredPolicy, decision_set_v1
 
 SHORT_HORIZONS = {

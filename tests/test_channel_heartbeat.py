@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.cli import episode_setup
 from baselines.episodes import run_episode
+from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import DecisionSet, decision_set_v1
 from etsc_envs.triggers import ClusterContainmentTrigger
 from etsc_envs.triggers.base import (

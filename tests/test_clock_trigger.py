@@ -22,7 +22,7 @@ import pytest
 from test_batch import SEEDS, SHORT_HORIZONS, assert_same_record
 
 from baselines.batch import run_batch
-from baselines.cli import episode_setup
+from baselines.policy_specs import episode_setup
 from etsc_envs.triggers import ClockTrigger, PeriodicPolicy
 
 EVERY = 7

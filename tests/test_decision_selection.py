@@ -18,7 +18,7 @@ from agents.train.decision_selection import (
 from agents.train.training import main
 from agents.train.validation_callback import deployment, set_summary
 from baselines.batch import run_batch
-from baselines.cli import episode_setup
+from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import FixedDecision, SelfTriggeredPolicy, decision_set_v1
 from etsc_envs.protocol import scenario_set
 from etsc_envs.triggers.base import RuleTrigger

@@ -20,7 +20,8 @@ import time
 from typing import Any
 
 from baselines.batch import run_batch
-from baselines.cli import episode_setup, limit_torch_threads
+from baselines.cli import limit_torch_threads
+from baselines.policy_specs import episode_setup
 from etsc_envs.protocol import scenario_set
 
 

@@ -46,15 +46,9 @@ import numpy as np
 
 import etsc_envs
 from agents.sweep.results import finished_trials
-from baselines.cli import (
-    episode_setup,
-    limit_torch_threads,
-    model_spec,
-    parse_assignments,
-    require_policies,
-    write_json,
-)
+from baselines.cli import limit_torch_threads, model_spec, parse_assignments, write_json
 from baselines.evaluate import evaluate, positive_integer
+from baselines.policy_specs import episode_setup, require_policies
 from baselines.statistics import paired_ratio, seeds_ratio
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.papers import PAPER_IDS, paper_of

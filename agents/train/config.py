@@ -108,7 +108,7 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
 from agents.train.decision_selection import BEST_DECISION
-from baselines.cli import require_env_id
+from baselines.policy_specs import require_env_id
 from etsc_envs.core.files import require_writable_folder
 from etsc_envs.decisions import DecisionSet, make_decision_env
 from etsc_envs.protocol import require_training_seeds

@@ -32,8 +32,8 @@ from typing import Any
 
 from agents.train.validation_callback import deployment, set_summary
 from baselines.batch import run_batch
-from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
+from baselines.policy_specs import EpisodeSetup, episode_setup
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.decisions import DecisionSet, FixedDecision, Hold, SelfTriggeredPolicy
 from etsc_envs.protocol import scenario_set

@@ -35,7 +35,7 @@ from gymnasium import spaces
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
-from baselines.cli import episode_setup
+from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import DecisionSet, FixedDecision
 
 

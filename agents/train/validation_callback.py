@@ -17,8 +17,8 @@ from stable_baselines3.common.callbacks import BaseCallback
 
 from agents.train.model_files import write_model
 from baselines.batch import run_batch
-from baselines.cli import EpisodeSetup, episode_setup
 from baselines.episodes import to_jsonable
+from baselines.policy_specs import EpisodeSetup, episode_setup
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy
 from etsc_envs.protocol import scenario_set

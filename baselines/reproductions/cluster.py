@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 import etsc_envs
-from baselines.cli import make_agent_policy
 from baselines.episodes import EpisodeTrace, run_parallel_episode
+from baselines.policy_specs import make_agent_policy
 from baselines.reproductions.cluster_figures import draw_figures
 from baselines.reproductions.report import (
     Scenario,

@@ -23,9 +23,9 @@ import gymnasium as gym
 import matplotlib.pyplot as plt
 import numpy as np
 
-from baselines.cli import make_policy
 from baselines.episodes import instants_bar
 from baselines.plotting import plot_interevent, save
+from baselines.policy_specs import make_policy
 from baselines.reproductions.report import (
     Scenario,
     claim,

@@ -13,8 +13,8 @@ from typing import Any
 import gymnasium as gym
 
 import etsc_envs
-from baselines.cli import make_policy
 from baselines.episodes import EpisodeTrace, run_episode
+from baselines.policy_specs import make_policy
 from baselines.progress import current_job
 
 TEXT_WIDTH = 100
