@@ -60,7 +60,7 @@ from etsc_envs.triggers.base import RuleTrigger
 from etsc_envs.triggers.family import (
     FamilyPoint,
     LearnedTrigger,
-    family_trigger_class,
+    family_trigger,
     scaled_thresholds,
 )
 
@@ -244,14 +244,14 @@ class TriggerAction:
         sampling_period_s: float,
     ) -> RuleTrigger:
         """The family's trigger at this action's point, for an env of these spaces."""
-        family: Any = family_trigger_class(self.trigger_class(env_id))
-        return family(
+        return family_trigger(
+            self.trigger_class(env_id),
+            self.point,
+            self.keywords,
             observation_space,
             action_space,
             observation_names,
-            self.point,
             sampling_period_s,
-            **self.keywords,
         )
 
     def to_json(self) -> dict[str, Any]:

@@ -468,6 +468,24 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
     return FamilyTrigger
 
 
+def family_trigger(
+    trigger_class: type[RuleTrigger],
+    point: FamilyPoint,
+    keywords: Mapping[str, Any],
+    observation_space: gym.Space,
+    action_space: gym.Space,
+    observation_names: tuple[str, ...],
+    sampling_period_s: float,
+) -> RuleTrigger:
+    """The family of ``trigger_class`` at ``point`` (with the trigger's fixed ``keywords``) as
+    a trigger policy for an env of these spaces, observation names and sampling period."""
+    # Built with FamilyTrigger's own constructor arguments (family_trigger_class).
+    family = cast(Callable[..., RuleTrigger], family_trigger_class(trigger_class))
+    return family(
+        observation_space, action_space, observation_names, point, sampling_period_s, **keywords
+    )
+
+
 @dataclass(frozen=True)
 class LearnedTrigger:
     """A learned trigger as the file ``agents.search`` writes: the environment id, the paper
@@ -554,13 +572,12 @@ class LearnedTrigger:
         families = {paper.trigger.__name__: paper.trigger for paper in PAPERS}
         if self.family not in families:
             raise ValueError(f"family must be one of {sorted(families)}, got {self.family!r}")
-        # Built with FamilyTrigger's own constructor arguments (family_trigger_class).
-        family = cast(Callable[..., RuleTrigger], family_trigger_class(families[self.family]))
-        return family(
+        return family_trigger(
+            families[self.family],
+            self.point,
+            self.keywords,
             observation_space,
             action_space,
             observation_names,
-            self.point,
             sampling_period_s,
-            **self.keywords,
         )
