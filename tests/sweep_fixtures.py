@@ -1,7 +1,10 @@
-"""The tiny sweep that the sweep tests run, written into a test's temporary folder."""
+"""The tiny sweep that the sweep tests run, written into a test's temporary folder, and the
+sweep command run where Ray cannot be imported."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -20,3 +23,16 @@ def tiny_sweep(tmp_path: Path, **keys: Any) -> Path:
     path = tmp_path / "sweep.yaml"
     path.write_text(yaml.safe_dump(raw, sort_keys=False), encoding="utf-8")
     return path
+
+
+def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:
+    """The sweep command in a Python where ``import ray`` fails (the worker-process path)."""
+    code = (
+        "import sys\n"
+        "sys.modules['ray'] = None  # as if Ray were not installed\n"
+        "from agents.sweep.runner import main\n"
+        f"raise SystemExit(main({list(arguments)!r}))\n"
+    )
+    return subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=900
+    )

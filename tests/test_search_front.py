@@ -6,8 +6,6 @@ checked before any trial starts."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -17,10 +15,10 @@ import yaml
 from agents.search.cma_es import Evaluator, config_from_dict, run_search
 from agents.sweep.config import sweep_config_from_dict
 from agents.sweep.results import sweep_models
+from tests.sweep_fixtures import sweep_without_ray
 
 pytest.importorskip("stable_baselines3")
 
-ROOT = Path(__file__).resolve().parents[1]
 SEARCH = {
     "env_id": "etsc/AttitudeTracking-v0",
     "penalty": 100.0,
@@ -53,18 +51,6 @@ def _sweep(tmp_path: Path, **changes: Any) -> Path:
     return path
 
 
-def _sweep_command(*arguments: str) -> subprocess.CompletedProcess:
-    code = (
-        "import sys\n"
-        "sys.modules['ray'] = None  # the worker-process path, as without Ray\n"
-        "from agents.sweep.runner import main\n"
-        f"raise SystemExit(main({list(arguments)!r}))\n"
-    )
-    return subprocess.run(
-        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=900
-    )
-
-
 def _generations(folder: Path) -> list[dict[str, Any]]:
     records = [
         json.loads(line) for line in (folder / "generations.jsonl").read_text().split("\n") if line
@@ -78,13 +64,13 @@ def _generations(folder: Path) -> list[dict[str, Any]]:
 def front(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     tmp_path = tmp_path_factory.mktemp("search_front")
     config = _sweep(tmp_path)
-    first = _sweep_command("--config", str(config), "--processes", "2")
+    first = sweep_without_ray("--config", str(config), "--processes", "2")
     results_dir = tmp_path / "front"
     times = {
         folder.name: (folder / "learned.json").stat().st_mtime_ns
         for folder in (results_dir / "trials").iterdir()
     }
-    resumed = _sweep_command("--config", str(config), "--processes", "1", "--resume")
+    resumed = sweep_without_ray("--config", str(config), "--processes", "1", "--resume")
     return {"tmp": tmp_path, "results_dir": results_dir, "first": first, "times": times,
             "resumed": resumed}  # fmt: skip
 

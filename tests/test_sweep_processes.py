@@ -5,33 +5,17 @@ refusals of what it cannot run."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from tests.sweep_fixtures import tiny_sweep
+from tests.sweep_fixtures import sweep_without_ray, tiny_sweep
 
 pytest.importorskip("stable_baselines3")
 
-ROOT = Path(__file__).resolve().parents[1]
 FINISHING = ("transmission_penalty=30", "transmission_penalty=100")
 CRASHING = "transmission_penalty=-1"
-
-
-def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:
-    """The sweep command in a Python where ``import ray`` fails."""
-    code = (
-        "import sys\n"
-        "sys.modules['ray'] = None  # as if Ray were not installed\n"
-        "from agents.sweep.runner import main\n"
-        f"raise SystemExit(main({list(arguments)!r}))\n"
-    )
-    return subprocess.run(
-        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=900
-    )
 
 
 @pytest.fixture(scope="module")
