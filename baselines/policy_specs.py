@@ -25,6 +25,7 @@ from etsc_envs.triggers.base import (
     ClockTrigger,
     HeartbeatPolicy,
     instants_seconds,
+    policy_interface,
     timed_rule_class,
 )
 from etsc_envs.triggers.family import LearnedTrigger
@@ -122,15 +123,8 @@ class EpisodeSetup(NamedTuple):
     def policy_spaces(self) -> tuple[gym.Space, gym.Space, tuple[str, ...]]:
         """The observation space, action space and observation names a policy acts with
         (one agent's, for a PettingZoo id)."""
-        env = self.env
-        if callable(env.observation_space):
-            agent = env.possible_agents[0]
-            return (
-                env.observation_space(agent),
-                env.action_space(agent),
-                tuple(env.unwrapped.agent_observation_names),
-            )
-        return env.observation_space, env.action_space, tuple(env.unwrapped.observation_names)
+        observation_space, action_space, names, _ = policy_interface(self.env)
+        return observation_space, action_space, names
 
 
 def require_env_id(env_id: Any, argument: str = "env_id") -> str:

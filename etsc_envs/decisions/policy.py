@@ -17,7 +17,7 @@ import numpy as np
 from etsc_envs.decisions.actions import DecisionSet, decision_set_path
 from etsc_envs.decisions.schedule import IntervalSchedule
 from etsc_envs.sb3_models import env_id_of, load_sb3, takes_action_masks
-from etsc_envs.triggers.base import batched_observations
+from etsc_envs.triggers.base import batched_observations, policy_interface
 
 
 class FixedDecision:
@@ -76,26 +76,7 @@ class SelfTriggeredPolicy:
     def for_env(cls, model: Any, decisions: DecisionSet, env: Any) -> SelfTriggeredPolicy:
         """The policy for ``env``: a Gymnasium env of the suite, or a PettingZoo parallel env
         (one row of interval state per agent, queried with their observations stacked)."""
-        if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
-            agent = env.possible_agents[0]
-            unwrapped = env.unwrapped
-            return cls(
-                model,
-                decisions,
-                env.observation_space(agent),
-                env.action_space(agent),
-                tuple(unwrapped.agent_observation_names),
-                float(unwrapped.loop.params.sampling_period_s),
-            )
-        unwrapped = env.unwrapped
-        return cls(
-            model,
-            decisions,
-            env.observation_space,
-            env.action_space,
-            tuple(unwrapped.observation_names),
-            float(unwrapped.params.sampling_period_s),
-        )
+        return cls(model, decisions, *policy_interface(env))
 
     def choose(self, obs: np.ndarray, deterministic: bool = True) -> np.ndarray:
         """The model's (shielded) actions at decision instants with observations ``obs``."""
@@ -174,23 +155,5 @@ def load_sb3_policy(path: str | Path, env: Any) -> Any:
     queried with their observations stacked): :func:`sb3_policy` with the env's spaces,
     observation names, sampling period and id (:func:`~etsc_envs.sb3_models.env_id_of`).
     ``ValueError`` naming the model and both envs when it was trained for other spaces."""
-    env_id = env_id_of(env)
-    unwrapped = env.unwrapped
-    if callable(getattr(env, "observation_space", None)):  # PettingZoo: one agent's view
-        agent = env.possible_agents[0]
-        return sb3_policy(
-            path,
-            env.observation_space(agent),
-            env.action_space(agent),
-            tuple(unwrapped.agent_observation_names),
-            float(unwrapped.loop.sampling_period_s),
-            env_id,
-        )
-    return sb3_policy(
-        path,
-        env.observation_space,
-        env.action_space,
-        tuple(unwrapped.observation_names),
-        float(unwrapped.sampling_period_s),
-        env_id,
-    )
+    env_id = env_id_of(env)  # first: an env not of the suite is refused by name
+    return sb3_policy(path, *policy_interface(env), env_id)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -35,6 +35,36 @@ def batched_observations(obs: np.ndarray, observation_space: gym.Space) -> tuple
     obs = np.asarray(obs)
     single = obs.shape == observation_space.shape
     return (obs[None] if single else obs), single
+
+
+class PolicyInterface(NamedTuple):
+    """What a trigger policy of an env is built for: the spaces it acts in, the names of its
+    observation's entries and the env's sampling period (one agent's, for a PettingZoo env)."""
+
+    observation_space: gym.Space
+    action_space: gym.Space
+    observation_names: tuple[str, ...]
+    sampling_period_s: float
+
+
+def policy_interface(env: Any) -> PolicyInterface:
+    """The :class:`PolicyInterface` of ``env``: a Gymnasium env of the suite, or a PettingZoo
+    parallel env, whose agents share one policy (queried with their observations stacked)."""
+    unwrapped = env.unwrapped
+    if callable(getattr(env, "observation_space", None)):  # a PettingZoo env: one agent's view
+        agent = env.possible_agents[0]
+        return PolicyInterface(
+            env.observation_space(agent),
+            env.action_space(agent),
+            tuple(unwrapped.agent_observation_names),
+            float(unwrapped.loop.sampling_period_s),
+        )
+    return PolicyInterface(
+        env.observation_space,
+        env.action_space,
+        tuple(unwrapped.observation_names),
+        float(unwrapped.sampling_period_s),
+    )
 
 
 class TriggerPolicy:

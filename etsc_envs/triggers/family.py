@@ -49,6 +49,7 @@ from etsc_envs.core.jit import closure_jit, jit
 from etsc_envs.triggers.base import (
     RuleTrigger,
     instants_seconds,
+    policy_interface,
     time_since_transmission_indices,
     transmit_bits,
 )
@@ -548,16 +549,7 @@ class LearnedTrigger:
         """The trigger policy of this point for ``env``: a Gymnasium env of the suite, or a
         PettingZoo parallel env (one policy for every agent, queried with their observations
         stacked)."""
-        if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
-            agent = env.possible_agents[0]
-            spaces = (env.observation_space(agent), env.action_space(agent))
-            names = tuple(env.unwrapped.agent_observation_names)
-            period = env.unwrapped.loop.sampling_period_s
-        else:
-            spaces = (env.observation_space, env.action_space)
-            names = tuple(env.unwrapped.observation_names)
-            period = env.unwrapped.sampling_period_s
-        return self.trigger(*spaces, names, period)
+        return self.trigger(*policy_interface(env))
 
     def trigger(
         self,
