@@ -190,15 +190,8 @@ class TriggerAction:
         rule, its point's factors, its keywords."""
         trigger = self.trigger_class(env_id)
         scaled_thresholds(trigger, self.point.factors)
-        parameters = inspect.signature(trigger).parameters
         thresholds = {kw for keywords in trigger.threshold_groups.values() for kw in keywords}
-        allowed = sorted(
-            name
-            for name, parameter in parameters.items()
-            if parameter.kind is inspect.Parameter.POSITIONAL_OR_KEYWORD
-            and parameter.default is not inspect.Parameter.empty
-            and name not in thresholds
-        )
+        allowed = _keywords_besides(trigger, thresholds)
         unknown = sorted(set(self.keywords) - set(allowed))
         if unknown:
             raise ValueError(
@@ -628,6 +621,18 @@ def read_v1(record: Mapping[str, Any]) -> DecisionSet:
     return DecisionSet(str(env_id), tuple(actions), shield)
 
 
+def _keywords_besides(trigger: type[RuleTrigger], excluded: set[str]) -> list[str]:
+    """The keyword arguments with defaults of ``trigger``'s constructor, ``excluded`` left out,
+    sorted."""
+    return sorted(
+        name
+        for name, parameter in inspect.signature(trigger).parameters.items()
+        if parameter.kind is inspect.Parameter.POSITIONAL_OR_KEYWORD
+        and parameter.default is not inspect.Parameter.empty
+        and name not in excluded
+    )
+
+
 def _v1_rule_keywords(
     env_id: str, rule: str, given: Any
 ) -> tuple[dict[str, float], dict[str, float]]:
@@ -648,14 +653,7 @@ def _v1_rule_keywords(
         )
     paper = trigger.paper_thresholds()
     own_group = {kws[0]: group for group, kws in trigger.threshold_groups.items() if len(kws) == 1}
-    parameters = inspect.signature(trigger).parameters
-    allowed = sorted(
-        name
-        for name, parameter in parameters.items()
-        if parameter.kind is inspect.Parameter.POSITIONAL_OR_KEYWORD
-        and parameter.default is not inspect.Parameter.empty
-        and name not in scaled
-    )
+    allowed = _keywords_besides(trigger, scaled)
     unknown = sorted(set(given) - set(allowed))
     if unknown:
         raise ValueError(

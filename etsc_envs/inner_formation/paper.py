@@ -12,14 +12,7 @@ from etsc_envs.triggers.inner_formation import (
     InnerFormationErrorTimeTrigger,
     InnerFormationShield,
     InnerFormationTrigger,
-    default_error_time_thresholds,
 )
-
-
-def _error_time_thresholds() -> dict[str, float]:
-    area1, area2, area3 = default_error_time_thresholds()
-    return {"area1": float(area1), "area2": float(area2), "area3": float(area3)}
-
 
 PAPER = Paper(
     number="004",
@@ -29,7 +22,7 @@ PAPER = Paper(
     rule=Rule(InnerFormationTrigger, InnerFormationTrigger.paper_thresholds),
     error_time=Rule(
         InnerFormationErrorTimeTrigger,
-        _error_time_thresholds,
+        InnerFormationErrorTimeTrigger.paper_thresholds,
         sweep_scales=(0.5, 1.0, 2.0, 4.0, 8.0, 16.0),
     ),
     shield=InnerFormationShield,
