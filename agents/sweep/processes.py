@@ -28,7 +28,7 @@ from agents.sweep.results import (
     SweepTrial,
     final_scores,
     one_line_error,
-    training_finished,
+    trial_finished,
     trial_status,
     write_summary,
 )
@@ -89,7 +89,7 @@ def run_sweep_in_processes(
     pending = {
         name: values
         for name, values in points.items()
-        if not training_finished(sweep.trial_folder(name))
+        if not trial_finished(sweep.trial_folder(name))
     }
     errors: dict[str, str | None] = {}
     if pending:

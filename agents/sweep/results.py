@@ -141,7 +141,7 @@ class SweepTrial:
         }
 
 
-def training_finished(folder: str | Path) -> bool:
+def trial_finished(folder: str | Path) -> bool:
     """Whether the trial in ``folder`` finished: ``agents.train`` writes its summary last,
     after the model, and ``agents.search`` its learned trigger after its last generation."""
     folder = Path(folder)
@@ -150,11 +150,11 @@ def training_finished(folder: str | Path) -> bool:
 
 
 def trial_status(folder: Path, error: str | None) -> str:
-    """``failed`` if the trial raised, else ``finished`` if its training finished, else
-    ``incomplete``."""
+    """``failed`` if the trial raised, else ``finished`` if its run (training or search)
+    finished, else ``incomplete``."""
     if error is not None:
         return "failed"
-    return "finished" if training_finished(folder) else "incomplete"
+    return "finished" if trial_finished(folder) else "incomplete"
 
 
 def write_summary(results_dir: str | Path, sweep: dict[str, Any], trials: list[SweepTrial]) -> Path:

@@ -24,7 +24,7 @@ from agents.sweep.results import (
     final_scores,
     last_evaluation,
     scores,
-    training_finished,
+    trial_finished,
 )
 
 
@@ -68,7 +68,7 @@ def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
     it goes, and report the final scores once the model is saved."""
     name = sweep.trial_name(values, tune.get_context().get_trial_id())
     folder = sweep.trial_folder(name)
-    if not training_finished(folder):
+    if not trial_finished(folder):
         callbacks = []
         if sweep.learner == "train":
             timesteps = int(sweep.trial_mapping(values, folder)["total_timesteps"])
