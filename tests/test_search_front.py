@@ -121,3 +121,49 @@ def test_a_bad_search_front_is_refused_before_any_trial(tmp_path: Path, changes,
     raw = yaml.safe_load(_sweep(tmp_path, **changes).read_text())
     with pytest.raises(ValueError, match=message):
         sweep_config_from_dict(raw, "sweep.yaml")
+
+
+def test_a_grown_front_runs_only_its_new_points(tmp_path: Path) -> None:
+    first = _sweep(tmp_path, grid={"penalty": [30.0], "seed": [0]})
+    assert sweep_without_ray("--config", str(first), "--processes", "1").returncode == 0
+    trials = tmp_path / "front" / "trials"
+    before = {
+        folder.name: (folder / "learned.json").stat().st_mtime_ns for folder in trials.iterdir()
+    }
+    grown = _sweep(tmp_path, grid={"penalty": [30.0], "seed": [0, 1]})
+    resumed = sweep_without_ray("--config", str(grown), "--processes", "1", "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+    summary = json.loads((tmp_path / "front" / "sweep_summary.json").read_text())
+    assert [trial["values"] for trial in summary["trials"]] == [
+        {"penalty": 30.0, "seed": 0},
+        {"penalty": 30.0, "seed": 1},
+    ]
+    assert [trial["status"] for trial in summary["trials"]] == ["finished"] * 2
+    for name, mtime in before.items():  # the seed-0 search did not run again
+        assert (trials / name / "learned.json").stat().st_mtime_ns == mtime
+    settings = json.loads((tmp_path / "front" / "sweep_settings.json").read_text())
+    assert settings["grid"]["seed"] == [0, 1]
+
+
+def test_a_grid_that_lost_a_value_is_refused(tmp_path: Path) -> None:
+    started = sweep_config_from_dict(yaml.safe_load(_sweep(tmp_path).read_text()), "sweep.yaml")
+    started.start_or_continue(resume=False, started=False)
+    changed = sweep_config_from_dict(
+        yaml.safe_load(_sweep(tmp_path, grid={"penalty": [30.0], "seed": [0]}).read_text()),
+        "sweep.yaml",
+    )
+    with pytest.raises(ValueError, match=r"the sweep's \['grid'\] changed"):
+        changed.start_or_continue(resume=True, started=True, grid_may_grow=True)
+
+
+def test_tune_does_not_continue_a_grown_grid(tmp_path: Path) -> None:
+    started = sweep_config_from_dict(yaml.safe_load(_sweep(tmp_path).read_text()), "sweep.yaml")
+    started.start_or_continue(resume=False, started=False)
+    grown = sweep_config_from_dict(
+        yaml.safe_load(
+            _sweep(tmp_path, grid={"penalty": list(PENALTIES), "seed": [0, 1]}).read_text()
+        ),
+        "sweep.yaml",
+    )
+    with pytest.raises(ValueError, match="continue a grown grid with --processes N"):
+        grown.start_or_continue(resume=True, started=True)

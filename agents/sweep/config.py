@@ -170,12 +170,16 @@ class SweepConfig:
         """Where the trial called ``name`` writes its training outputs."""
         return self.trials_dir / name
 
-    def start_or_continue(self, resume: bool, started: bool) -> None:
+    def start_or_continue(self, resume: bool, started: bool, grid_may_grow: bool = False) -> None:
         """Refuse to start over a sweep that has ``started`` (``--resume`` continues it, with
         the settings it started with); record a new sweep's settings in ``sweep_settings.json``.
 
         A resumed sweep runs the trials it planned when it started, so ``--resume`` with
-        changed settings is refused (they would mislabel the trials)."""
+        changed settings is refused (they would mislabel the trials). The one change allowed,
+        where ``grid_may_grow`` (the worker-process path, which runs every unfinished grid
+        point; Tune restores the grid it started with), is a grown grid: the same keys, each
+        keeping its values and perhaps adding some (more seeds, more penalties). Its finished
+        trials keep their names and results; the new points run."""
         path = Path(self.results_dir) / SETTINGS_FILE
         now = json.dumps(self.settings(), indent=2, sort_keys=True) + "\n"
         if not resume:
@@ -193,6 +197,14 @@ class SweepConfig:
         before = json.loads(path.read_text(encoding="utf-8"))
         after = json.loads(now)
         changed = sorted(key for key in {*before, *after} if before.get(key) != after.get(key))
+        if changed == ["grid"] and _grown(before["grid"], after["grid"]):
+            if grid_may_grow:
+                atomic_write_text(path, now)
+                return
+            raise ValueError(
+                "--resume: the sweep's grid grew since it started; Tune restores the grid it "
+                "started with, so continue a grown grid with --processes N"
+            )
         if changed:
             raise ValueError(
                 f"--resume: the sweep's {changed} changed since it started (see {str(path)!r}); "
@@ -532,3 +544,11 @@ def _first_value(spec: dict[str, list[Any]]) -> Any:
     """A distribution's lower bound, or a choice's first value."""
     (arguments,) = spec.values()
     return arguments[0]
+
+
+def _grown(before: dict[str, list[Any]], after: dict[str, list[Any]]) -> bool:
+    """Whether grid ``after`` has ``before``'s keys, each with every value it had (and perhaps
+    more): every trial of ``before`` is a trial of ``after``."""
+    return set(before) == set(after) and all(
+        all(value in after[key] for value in values) for key, values in before.items()
+    )

@@ -79,12 +79,12 @@ def _start_worker(stop: Any) -> None:
 def run_sweep_in_processes(
     sweep: SweepConfig, processes: int, resume: bool, description: dict[str, Any]
 ) -> list[SweepTrial]:
-    """Start the sweep (or continue it if ``resume``:
+    """Start the sweep (or continue it if ``resume``, a grown grid too:
     :meth:`~agents.sweep.config.SweepConfig.start_or_continue`), run the grid's unfinished
     trials, ``processes`` at a time, write the summary (with ``description``, the sweep's
     header) and return every trial in the grid's order."""
     check_process_sweep(sweep, processes)
-    sweep.start_or_continue(resume, sweep.trials_dir.exists())
+    sweep.start_or_continue(resume, sweep.trials_dir.exists(), grid_may_grow=True)
     points = {sweep.trial_name(values): values for values in sweep.grid_points()}
     pending = {
         name: values

@@ -21,7 +21,8 @@ trial failed, or when a front is incomplete, else 0.
 ``--processes N`` runs a grid sweep (kinds ``front`` and ``grid``, no scheduler or search)
 without Ray, N trials at a time in worker processes on this machine
 (:mod:`agents.sweep.processes`); it writes the same results folder, and ``--resume`` continues
-it by running the trials that had not finished.
+it by running the trials that had not finished, also after the config's grid has grown (more
+seeds or penalties: the finished trials are kept, the new points run).
 
 Needs the ``sweep`` extra (``pip install -e ".[train,sweep]"``), except with ``--processes``.
 """
