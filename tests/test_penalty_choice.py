@@ -1,0 +1,75 @@
+"""``agents.judge.penalty_choice``: a front's penalty is chosen from validation records only,
+as the largest whose seeds' mean chosen point contains the start's."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from agents.judge.penalty_choice import choose_penalty, main
+from agents.sweep.results import SweepTrial, write_summary
+
+START = (150.0, 0.0100)
+
+
+def _front(tmp_path: Path, chosen: dict[tuple[float, int], tuple[float, float]]) -> Path:
+    """A front of searches whose trial at (penalty, seed) chose the validation point given."""
+    trials = []
+    for (penalty, seed), (sent, cost) in chosen.items():
+        name = f"penalty={penalty:g},seed={seed}"
+        folder = tmp_path / "trials" / name
+        folder.mkdir(parents=True)
+        curve = [
+            {"generation": 0, "validation_transmissions": START[0], "validation_cost": START[1]},
+            {"generation": 1},
+            {"generation": 2, "validation_transmissions": sent, "validation_cost": cost},
+        ]
+        record = {"search": {"chosen_generation": 2}, "curve": curve}
+        (folder / "curve.json").write_text(json.dumps(record))
+        (folder / "learned.json").write_text("{}")
+        values = {"penalty": penalty, "seed": seed}
+        trials.append(SweepTrial(name, values, "finished", None, folder, None))
+    write_summary(tmp_path, {"env_id": "etsc/AttitudeTracking-v0", "kind": "front"}, trials)
+    return tmp_path
+
+
+def test_the_largest_penalty_whose_mean_contains_the_start_is_chosen(tmp_path: Path) -> None:
+    front = _front(
+        tmp_path,
+        {
+            (30.0, 0): (170.0, 0.0090),  # more transmissions: does not contain
+            (30.0, 1): (160.0, 0.0091),
+            (100.0, 0): (140.0, 0.0099),  # contains
+            (100.0, 1): (148.0, 0.0098),
+            (300.0, 0): (120.0, 0.0099),  # one seed costs more, the mean still contains
+            (300.0, 1): (130.0, 0.01005),
+            (1000.0, 0): (100.0, 0.0120),  # costs more: does not contain
+            (1000.0, 1): (110.0, 0.0110),
+        },
+    )
+    choice = choose_penalty(front)
+    assert [row["contains_start"] for row in choice["penalties"]] == [False, True, True, False]
+    assert choice["chosen"] == 300.0
+    assert choice["penalties"][2]["learned"] == {
+        "transmissions": 125.0,
+        "mean_cost": pytest.approx(0.009975),
+    }
+
+
+def test_no_penalty_is_chosen_where_none_contains(tmp_path: Path, capsys) -> None:
+    front = _front(tmp_path, {(1.0, 0): (300.0, 0.009), (10.0, 0): (100.0, 0.011)})
+    assert choose_penalty(front)["chosen"] is None
+    assert main([str(front)]) == 0
+    assert "chosen: no penalty contains the start" in capsys.readouterr().out
+
+
+def test_an_unfinished_trial_is_refused(tmp_path: Path, capsys) -> None:
+    front = _front(tmp_path, {(1.0, 0): (100.0, 0.009)})
+    summary = json.loads((front / "sweep_summary.json").read_text())
+    summary["trials"][0]["status"] = "incomplete"
+    (front / "sweep_summary.json").write_text(json.dumps(summary))
+    with pytest.raises(SystemExit):
+        main([str(front)])
+    assert "is incomplete; finish the sweep first" in capsys.readouterr().err
