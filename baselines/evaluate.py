@@ -12,13 +12,16 @@ since its last transmission; with both, as always taking the self-triggered deci
 (paper 004's error-time rule, ``--policy-arg area=A`` in m·s,
 :attr:`etsc_envs.core.paper.Paper.error_time`; ``heartbeat=H`` pairs it too), ``periodic``
 (``--policy-arg every=K``; with ``then_every=K2`` and ``switch_after=N`` the period becomes
-K2 at instant N), ``always``, or ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3
-model). ``--scenarios`` runs a fixed scenario set of the test protocol (docs/protocol.md);
-``--episodes/--seed`` run ad-hoc draws instead. The JSON holds every episode's record, the
-means, and the aggregates with 95 % intervals (mean, median, IQM of mean_cost, transmissions
-and return; failure rate). ``--windows 0,20,60,300`` splits every episode by time: each
-record gets the summed per-step cost and the transmissions of each window (``windows``), and
-the result their means over the episodes, to see where in an episode a trigger gains or loses.
+K2 at instant N), ``always``, ``sb3:PATH_TO_ZIP`` (a trained Stable-Baselines3
+model), or ``learned:PATH`` (a learned trigger file of ``agents.search``; ``--policy-arg
+heartbeat_instants=H``, ``floor_instants=F`` or ``exponent=P`` replaces that component of its
+θ, ``heartbeat_instants=inf`` removing the heartbeat). ``--scenarios`` runs a fixed scenario
+set of the test protocol (docs/protocol.md); ``--episodes/--seed`` run ad-hoc draws instead.
+The JSON holds every episode's record, the means, and the aggregates with 95 % intervals
+(mean, median, IQM of mean_cost, transmissions and return; failure rate). ``--windows
+0,20,60,300`` splits every episode by time: each record gets the summed per-step cost and the
+transmissions of each window (``windows``), and the result their means over the episodes, to
+see where in an episode a trigger gains or loses.
 """
 
 from __future__ import annotations

@@ -5,6 +5,7 @@ commands, the batch evaluator and training-time validation share."""
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 from collections.abc import Callable
@@ -34,6 +35,10 @@ POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP | lea
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
 (:mod:`etsc_envs.decisions`)."""
 
+LEARNED_POINT_ARGUMENTS = ("floor_instants", "heartbeat_instants", "exponent")
+"""The components of a learned trigger's θ that ``--policy-arg`` may replace, to read how its
+cost and transmissions depend on each (``heartbeat_instants=inf``: no heartbeat)."""
+
 
 def check_policy_arguments(spec: str, policy_args: dict[str, Any], env_id: str) -> None:
     """``ValueError`` naming the ``--policy-arg`` that ``spec`` does not take, or whose value is
@@ -42,6 +47,14 @@ def check_policy_arguments(spec: str, policy_args: dict[str, Any], env_id: str) 
     Other specs (models) are checked where they are loaded."""
     if spec.startswith("sb3:") and not spec.removeprefix("sb3:"):
         raise ValueError("--policy sb3: needs the path of a model zip, e.g. sb3:models/NAME.zip")
+    if spec.startswith("learned:"):
+        for key, value in policy_args.items():
+            if key not in LEARNED_POINT_ARGUMENTS:
+                takes = ", ".join(LEARNED_POINT_ARGUMENTS)
+                raise ValueError(f"--policy-arg {key}: a learned trigger takes {takes}")
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"--policy-arg {key} must be a number, got {value!r}")
+        return
     counts = {"every", "then_every", "switch_after"} if spec == "periodic" else set()
     numbers: set[str] = set()
     if spec in RULE_NAMES and env_id in ids_with_rule(spec):
@@ -236,9 +249,13 @@ def _policy_for(
         trigger = trigger_class(observation_space, action_space, names, **{**arguments, **bound})
         return trigger if heartbeat is None else HeartbeatPolicy(trigger, heartbeat)
     if spec.startswith("learned:"):
-        if policy_args:
-            raise ValueError(f"--policy-arg is not used by learned triggers, got {policy_args}")
         learned = LearnedTrigger.load(spec.removeprefix("learned:"))
+        if policy_args:
+            try:
+                point = dataclasses.replace(learned.point, **policy_args)
+            except ValueError as error:
+                raise ValueError(f"--policy-arg {error}") from None
+            learned = dataclasses.replace(learned, point=point)
         expected = paper_of(env_id).trigger.__name__
         if learned.family != expected:
             raise ValueError(

@@ -274,3 +274,28 @@ def test_load_policy_runs_a_learned_file_from_the_package(tmp_path) -> None:
         obs, *_ = env.step(action)
     with pytest.raises(ValueError, match="path"):
         etsc_envs.load_policy(str(tmp_path / "model.pkl"), env)
+
+
+def test_a_policy_arg_replaces_one_component_of_a_learned_theta(tmp_path) -> None:
+    """``--policy learned:PATH --policy-arg heartbeat_instants=H`` runs the file's θ with that
+    component replaced: the records of the file written with it; bad keys get one line."""
+    from baselines.evaluate import evaluate
+
+    point = FamilyPoint(factors={"psi": 8.0}, heartbeat_instants=384, exponent=0.3)
+    original, changed = tmp_path / "original.json", tmp_path / "changed.json"
+    family = ("etsc/AttitudeTracking-v0", "AttitudeTrackingTrigger")
+    LearnedTrigger(*family, point).save(original)
+    LearnedTrigger(*family, FamilyPoint(factors={"psi": 8.0}, exponent=0.3)).save(changed)
+    episode = {"env_args": {"horizon_s": 3.0}, "episodes": 2, "processes": 1}
+    replaced = evaluate(
+        family[0], f"learned:{original}", policy_args={"heartbeat_instants": math.inf}, **episode
+    )
+    written = evaluate(family[0], f"learned:{changed}", **episode)
+    kept = evaluate(family[0], f"learned:{original}", **episode)
+    for key in ("transmissions", "mean_cost"):
+        assert [e[key] for e in replaced["episodes"]] == [e[key] for e in written["episodes"]]
+    assert replaced["mean"]["transmissions"] != kept["mean"]["transmissions"]
+    with pytest.raises(ValueError, match="--policy-arg psi: a learned trigger takes floor_"):
+        evaluate(family[0], f"learned:{original}", policy_args={"psi": 2.0}, **episode)
+    with pytest.raises(ValueError, match="--policy-arg heartbeat_instants must be >= 1"):
+        evaluate(family[0], f"learned:{original}", policy_args={"heartbeat_instants": 0}, **episode)
