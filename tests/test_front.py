@@ -182,3 +182,30 @@ def test_pareto_judges_searched_methods_against_every_hand_point():
     result["curves"]["learned"].pop()
     verdicts = front_verdicts(result)
     assert verdicts["search"]["set_menu"]["met"] and verdicts["search"]["paper_menu"]["met"]
+
+
+def test_a_front_of_searches_is_judged_against_the_menu_per_penalty():
+    """Seeds of one penalty are one method; a front's penalties are not pooled as seeds."""
+
+    def trial(penalty: float, seed: int, sent: float, cost: float) -> dict:
+        path = f"learned:front/trials/penalty={penalty:g},seed={seed}/learned.json"
+        return {**bounded(sent, cost, policy=path), "method": "front"}
+
+    result = {
+        "curves": {
+            "paper": MENU[:2],
+            "periodic": [bounded(1600, 1.0, policy="periodic")],
+            "learned": [trial(10, 0, 170, 3.0), trial(10, 1, 170, 3.0), trial(1, 0, 1600, 1.0)],
+        }
+    }
+    verdicts = front_verdicts(result)
+    assert "set_menu" not in verdicts["front"] and "set" in verdicts["front"]
+    assert verdicts["front penalty=10"]["set_menu"]["met"]  # x0.85 at equal cost
+    assert verdicts["front penalty=10"]["set_menu"]["seeds"] == [(170.0, 3.0)] * 2
+    assert not verdicts["front penalty=1"]["set_menu"]["met"]
+    assert "paper_menu" in verdicts["front penalty=1"]
+    one_penalty = {
+        **result,
+        "curves": {**result["curves"], "learned": result["curves"]["learned"][:2]},
+    }
+    assert front_verdicts(one_penalty)["front"]["set_menu"]["met"]

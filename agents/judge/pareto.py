@@ -38,6 +38,8 @@ A method of ``learned:`` triggers (a search's) is also judged against the **hand
 the envelope of every point that no search found: the sweeps, every other model, and every
 point of each ``--menu`` result (earlier fronts: the pinned rule variants of the decision sets,
 the headlines among them), drawn as a curve of its own (:func:`agents.judge.front.menu_verdict`).
+The seeds of one search setting are one method there: a ``--sweep`` front over penalties is
+judged per penalty (:func:`search_groups`).
 
 Writes ``pareto.json`` and ``pareto.png`` into ``DIR`` (default
 ``results/pareto/<env name>``). ``--reuse PARETO_JSON`` keeps the paper, periodic (and other
@@ -241,25 +243,46 @@ def pareto(
 def front_verdicts(result: dict[str, Any]) -> dict[str, dict[str, Any]]:
     """Each learned method's front against the paper and periodic sweeps
     (:func:`agents.judge.front.front_verdict`), on the scenario set (``set``) and on the paper
-    scenario (``paper``, where its points ran there)."""
+    scenario (``paper``, where its points ran there); and, for a method of searches, the hand
+    menu's verdict (``set_menu``, ``paper_menu``) over its search seeds. A front of searches
+    over penalties (a sweep's trials ``penalty=…,seed=…``) is judged against the menu per
+    penalty, under ``"<method> penalty=…"``: seeds of one penalty are one method, a front's
+    penalties are not."""
     curves = result["curves"]
     verdicts: dict[str, dict[str, Any]] = {}
     menu = hand_menu(result)
     for method, points in learned_methods(result):
         verdicts[method] = {"set": front_verdict(points, curves["paper"], curves["periodic"])}
         searched = all(str(point.get("policy")).startswith("learned:") for point in points)
-        if searched:
-            verdicts[method]["set_menu"] = menu_verdict(points, menu, set_axes)
-        if all(point.get("paper_scenario") is not None for point in points):
+        groups = search_groups(method, points) if searched else {}
+        on_paper = all(point.get("paper_scenario") is not None for point in points)
+        if on_paper:
             try:
                 verdicts[method]["paper"] = front_verdict(
                     points, curves["paper"], curves["periodic"], paper_scenario_axes
                 )
             except ValueError:
-                continue
-            if searched:
-                verdicts[method]["paper_menu"] = menu_verdict(points, menu, paper_scenario_axes)
+                on_paper = False
+        for name, seeds in groups.items():
+            verdicts.setdefault(name, {})["set_menu"] = menu_verdict(seeds, menu, set_axes)
+            if on_paper:
+                verdicts[name]["paper_menu"] = menu_verdict(seeds, menu, paper_scenario_axes)
     return verdicts
+
+
+def search_groups(method: str, points: list[dict[str, Any]]) -> dict[str, list[dict[str, Any]]]:
+    """The seeds of each search setting among a method's ``learned:`` points, by name: the
+    method itself where its trigger files do not lie in sweep trials (``a=1,seed=0/``) or all
+    differ only in their seed, else ``"<method> <trial name without its seed>"`` per setting."""
+    groups: dict[str, list[dict[str, Any]]] = {}
+    for point in points:
+        trial = Path(str(point["policy"]).removeprefix("learned:")).parent.name
+        values = [part for part in trial.split(",") if "=" in part]
+        setting = ",".join(part for part in values if not part.startswith("seed="))
+        groups.setdefault(setting if values else "", []).append(point)
+    if len(groups) == 1:
+        return {method: points}
+    return {f"{method} {setting}".rstrip(): seeds for setting, seeds in groups.items()}
 
 
 def hand_menu(result: dict[str, Any]) -> list[dict[str, Any]]:
