@@ -566,6 +566,12 @@ def main(argv: list[str] | None = None) -> int:
             place = "paper scenario" if where.startswith("paper") else f"{args.scenarios} set"
             line = menu_line if where.endswith("_menu") else verdict_line
             print(line(method, place, verdict))
+    methods = {method for method, _ in learned_methods(result)}
+    if any(name not in methods for name in result["fronts"]):
+        print(
+            "a front's menu verdicts are per search setting; one is a claim only where that "
+            "setting was chosen on the validation set (python -m agents.judge.penalty_choice)"
+        )
     print(f"wrote {out_dir / 'pareto.json'} and {out_dir / 'pareto.png'}")
     return 0
 
