@@ -13,7 +13,7 @@ import yaml
 
 pytest.importorskip("stable_baselines3")
 
-from agents.sweep.config import load_sweep_config, sweep_config_from_dict
+from agents.sweep.config import SweepConfig, load_sweep_config, sweep_config_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = str(ROOT / "configs" / "train" / "attitude_tracking_ppo.yaml")
@@ -155,14 +155,32 @@ def test_a_front_sweep_ships_for_every_id() -> None:
     assert env_ids == set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
 
 
+def _penalties(config: SweepConfig) -> list[float]:
+    key = "penalty" if config.learner == "search" else "env_kwargs.transmission_penalty"
+    return config.grid[key]
+
+
 @pytest.mark.parametrize("path", SHIPPED_FRONTS, ids=lambda path: path.stem)
-def test_a_shipped_front_crosses_four_penalties_with_three_seeds(path: Path) -> None:
+def test_a_shipped_front_crosses_penalties_with_three_seeds(path: Path) -> None:
+    """Every shipped sweep is a front: at least two penalties (a refinement between two
+    penalties of a wider front, e.g. a larger search budget near the headline's rate) and three
+    seeds."""
     config = load_sweep_config(path)
     assert config.kind == "front"
-    penalty = "penalty" if config.learner == "search" else "env_kwargs.transmission_penalty"
-    assert len(config.grid[penalty]) >= 4
+    assert len(_penalties(config)) >= 2
     assert len(config.grid["seed"]) >= 3
     assert Path(config.results_dir).parts[-3:-1] == ("runs", "sweeps")
+
+
+def test_every_id_ships_a_front_of_four_penalties_with_three_seeds() -> None:
+    wide: dict[str, list[str]] = {}
+    for path in SHIPPED_FRONTS:
+        config = load_sweep_config(path)
+        if len(_penalties(config)) >= 4 and len(config.grid["seed"]) >= 3:
+            wide.setdefault(config.base["env_id"], []).append(path.stem)
+    import etsc_envs
+
+    assert set(wide) == set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
 
 
 def test_the_package_and_the_tools_do_not_import_ray() -> None:
