@@ -279,7 +279,7 @@ def search_groups(method: str, points: list[dict[str, Any]]) -> dict[str, list[d
         trial = Path(str(point["policy"]).removeprefix("learned:")).parent.name
         values = [part for part in trial.split(",") if "=" in part]
         setting = ",".join(part for part in values if not part.startswith("seed="))
-        groups.setdefault(setting if values else "", []).append(point)
+        groups.setdefault(setting, []).append(point)
     if len(groups) == 1:
         return {method: points}
     return {f"{method} {setting}".rstrip(): seeds for setting, seeds in groups.items()}
