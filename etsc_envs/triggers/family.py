@@ -489,15 +489,18 @@ def family_trigger(
 
 @dataclass(frozen=True)
 class LearnedTrigger:
-    """A learned trigger as the file ``agents.search`` writes: the environment id, the paper
-    trigger class whose family it belongs to, the point θ, the paper trigger's other keywords,
-    and what the search recorded (penalty, seeds, scores: data for the report)."""
+    """A point of a trigger family as a file: the environment id, the paper trigger class
+    whose family it belongs to, the point θ, the paper trigger's other keywords, and where the
+    point came from — ``search``, what ``agents.search`` recorded (penalty, seeds, scores), for
+    a learned trigger; ``hand``, the menu a hand-designed rule was chosen from and the
+    validation record that chose it (``models/<id>_hand.json``). Data for the report."""
 
     env_id: str
     family: str
     point: FamilyPoint
     keywords: Mapping[str, Any] = field(default_factory=dict)
     search: Mapping[str, Any] = field(default_factory=dict)
+    hand: Mapping[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -507,7 +510,8 @@ class LearnedTrigger:
             "family": self.family,
             "point": self.point.to_json(),
             "keywords": dict(self.keywords),
-            "search": dict(self.search),
+            **({"search": dict(self.search)} if self.search else {}),
+            **({"hand": dict(self.hand)} if self.hand else {}),
         }
 
     @classmethod
@@ -525,6 +529,7 @@ class LearnedTrigger:
             point=FamilyPoint.from_json(data["point"]),
             keywords=dict(data.get("keywords", {})),
             search=dict(data.get("search", {})),
+            hand=dict(data.get("hand", {})),
         )
 
     def save(self, path: str | Path) -> None:
