@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -299,3 +300,43 @@ def test_a_policy_arg_replaces_one_component_of_a_learned_theta(tmp_path) -> Non
         evaluate(family[0], f"learned:{original}", policy_args={"psi": 2.0}, **episode)
     with pytest.raises(ValueError, match="--policy-arg heartbeat_instants must be >= 1"):
         evaluate(family[0], f"learned:{original}", policy_args={"heartbeat_instants": 0}, **episode)
+
+
+HAND_FILES = sorted(Path(__file__).parents[1].glob("models/*_hand.json"))
+
+
+def test_every_id_ships_its_hand_point() -> None:
+    import etsc_envs
+
+    assert sorted(path.name.removesuffix("_hand.json") for path in HAND_FILES) == sorted(
+        env_id.removeprefix("etsc/")
+        for env_id in [*etsc_envs.ENV_IDS, *etsc_envs.PETTINGZOO_ENV_IDS]
+    )
+
+
+@pytest.mark.parametrize("path", HAND_FILES, ids=lambda path: path.name)
+def test_a_hand_point_is_where_its_search_starts_and_names_its_menu(path: Path) -> None:
+    """``models/<id>_hand.json`` is a point of the id's family (it loads with ``learned:``),
+    says what menu it was chosen from, and is the start of the id's search config: the
+    learned trigger is searched from the hand point it is judged against."""
+    import yaml
+
+    import etsc_envs
+    from agents.search.cma_es import load_config
+
+    hand = LearnedTrigger.load(path)
+    assert not hand.search and hand.hand["chosen_on"] == "validation"
+    assert hand.hand["menu"] and all(isinstance(label, str) for label in hand.hand["menu"])
+    configs = [
+        config
+        for config in Path(__file__).parents[1].glob("configs/search/*.yaml")
+        if yaml.safe_load(config.read_text())["env_id"] == hand.env_id
+    ]
+    assert len(configs) == 1, configs
+    assert load_config(configs[0]).start.to_json() == hand.point.to_json()
+    if hand.env_id in etsc_envs.ENV_IDS:
+        env = gym.make(hand.env_id)
+        policy = etsc_envs.load_policy(f"learned:{path}", env)
+        obs, _ = env.reset(seed=0)
+        action, _ = policy.predict(obs)
+        assert env.action_space.contains(np.asarray(action, dtype=env.action_space.dtype))
