@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import re
-from pathlib import Path
 
 import pytest
 
@@ -32,7 +31,7 @@ def test_every_figure_of_the_page_is_committed() -> None:
 def test_rows_read_the_records_they_name() -> None:
     rows = {row.trigger: row for row in leaderboard.board_rows(leaderboard.RECORDS, BOARD)}
     record = json.loads(
-        (leaderboard.RECORDS / BOARD.best / "results.json").read_text(encoding="utf-8")
+        (leaderboard.RECORDS / BOARD.hand / "results.json").read_text(encoding="utf-8")
     )
     recorded = record["sets"]["test"]["paper"]["aggregates"]["mean_cost"]
     paper = rows["paper's rule"].sets["test"]
@@ -41,48 +40,49 @@ def test_rows_read_the_records_they_name() -> None:
     assert paper.cost["mean"] == recorded["mean"]
     assert paper.cost["mean_ci95"] == recorded["mean_ci95"]
     assert paper.episodes == 64 and paper.failures == 0
-    # five pinned seeds that recorded the same episodes count as one run, their episodes five
-    best = rows["best hand-designed rule"].sets["test"]
-    assert best.episodes == 5 * 64
-    assert best.cost["mean"] == pytest.approx(
+    # the hand point is one deterministic trigger: one run of the test set
+    hand = rows[leaderboard.HAND].sets["test"]
+    assert hand.episodes == 64
+    assert hand.cost["mean"] == pytest.approx(
         record["sets"]["test"]["models"][0]["learned"]["mean"]["mean_cost"]
     )
-    # the clock runs at the best rule's rate: about its transmissions, and far fewer than always
+    assert "menu of 14 rules" in rows[leaderboard.HAND].what
+    # the clock runs at the hand point's rate: about its transmissions, far fewer than always
     clock = rows["clock"].sets["test"]
-    assert clock.sent["mean"] == pytest.approx(best.sent["mean"], rel=0.02)
+    assert clock.sent["mean"] == pytest.approx(hand.sent["mean"], rel=0.02)
     assert rows["always"].sets["test"].sent["mean"] == 50_000
+    learned = rows[leaderboard.LEARNED]
+    assert learned.sets["test"] is not None and learned.sets["test"].episodes == 5 * 64
 
 
-def test_a_learned_record_adds_its_row(tmp_path: Path) -> None:
-    records = tmp_path / "results"
-    records.mkdir()
-    for folder in {BOARD.sweeps, BOARD.best, f"{BOARD.name}_ppo", BOARD.self_triggered}:
-        assert folder is not None
-        (records / folder).symlink_to(leaderboard.RECORDS / folder)
-    triggers = [row.trigger for row in leaderboard.board_rows(records, BOARD)]
-    assert "learned trigger (ES)" not in triggers
+@pytest.mark.parametrize("board", leaderboard.BOARDS, ids=lambda board: board.name)
+def test_every_row_names_a_command_that_can_run_from_a_clone(board) -> None:
+    """Each row with a record names the command that makes it; the files that command reads
+    (models, configs) are in the repository, and it writes the record's own folder."""
+    rows = leaderboard.board_rows(leaderboard.RECORDS, board)
+    for row in rows:
+        if row.record == "—":
+            assert row.command is None and not any(row.sets.values()), row.trigger
+            continue
+        assert row.command is not None, row.trigger
+        folder = row.record.strip("`/").split("/")[0]
+        assert f"docs/results/{folder}" in row.command, (row.trigger, row.command)
+        for path in re.findall(r"(?:--model|--config) (\S+)", row.command):
+            assert (leaderboard.ROOT / path).is_file(), (row.trigger, path)
 
-    record = json.loads(
-        (leaderboard.RECORDS / BOARD.best / "results.json").read_text(encoding="utf-8")
+
+def test_the_command_of_a_record_lists_its_models_and_sets() -> None:
+    record = {
+        "env": "etsc/AttitudeTracking-v0",
+        "models": ["models/a.json", "models/b.json"],
+        "env_args": {"horizon_s": 10.0},
+        "sets": {"test": {}},
+    }
+    assert leaderboard.results_command(record, "X_learned/sub") == (
+        "python -m agents.results etsc/AttitudeTracking-v0 --model models/a.json "
+        "--model models/b.json --env-arg horizon_s=10.0 --scenarios test "
+        "--out docs/results/X_learned"
     )
-    for judged in record["sets"].values():
-        for model in judged["models"]:
-            for episode in model["learned"]["episodes"]:
-                episode["mean_cost"] /= 2.0
-    (records / f"{BOARD.name}_learned").mkdir()
-    (records / f"{BOARD.name}_learned" / "results.json").write_text(json.dumps(record))
-    rows = {row.trigger: row for row in leaderboard.board_rows(records, BOARD)}
-    learned, best = rows["learned trigger (ES)"], rows["best hand-designed rule"]
-    assert learned.record == f"`{BOARD.name}_learned/`"
-    for name in leaderboard.SETS:
-        assert learned.sets[name].cost["mean"] == pytest.approx(best.sets[name].cost["mean"] / 2)
-        assert learned.sets[name].sent["mean"] == best.sets[name].sent["mean"]
-
-    # a variant of the search gets its own row, named by its folder's suffix
-    (records / f"{BOARD.name}_learned_modulated").mkdir()
-    (records / f"{BOARD.name}_learned_modulated" / "results.json").write_text(json.dumps(record))
-    triggers = [row.trigger for row in leaderboard.board_rows(records, BOARD)]
-    assert triggers[-2:] == ["learned trigger (ES)", "learned trigger (ES, modulated)"]
 
 
 def test_records_of_other_scenarios_are_refused() -> None:
@@ -99,3 +99,29 @@ def test_records_of_other_scenarios_are_refused() -> None:
     )
     with pytest.raises(ValueError, match="other scenarios"):
         leaderboard._scenario_scores(shifted, paper)
+
+
+def test_the_readme_table_is_what_the_records_give() -> None:
+    boards = leaderboard.all_rows(leaderboard.RECORDS)
+    readme = leaderboard.README.read_text(encoding="utf-8")
+    table = leaderboard.readme_table(boards)
+    assert leaderboard.with_readme_table(readme, table) == readme, (
+        "README.md's table is stale: run python -m agents.leaderboard"
+    )
+    assert len(table) == 3 + len(leaderboard.BOARDS) + 1
+
+
+def test_the_best_rl_agent_meets_the_cost_bound_first() -> None:
+    def row(trigger: str, cost: float, sent: float, failures: int = 0) -> leaderboard.Row:
+        measure = leaderboard.Measure({"mean": cost}, {"mean": sent}, failures, 64)
+        return leaderboard.Row(trigger, "", "", {"test": measure, "paper": None})
+
+    paper = row("paper's rule", 1.0, 100.0)
+    cheap_many = row("per-instant PPO", 1.0, 90.0)
+    dear_few = row("self-triggered PPO", 1.2, 10.0)
+    assert leaderboard.best_rl_row([paper, cheap_many, dear_few]) is cheap_many
+    within_few = row("self-triggered PPO", 1.04, 10.0)
+    assert leaderboard.best_rl_row([paper, cheap_many, within_few]) is within_few
+    failed = row("self-triggered PPO", 1.0, 1.0, failures=1)
+    assert leaderboard.best_rl_row([paper, cheap_many, failed]) is cheap_many
+    assert leaderboard.best_rl_row([paper, row("per-instant PPO", 1, 1, 2), failed]) is None

@@ -7,19 +7,22 @@ Reads the judged records under ``docs/results/`` — ``results.json`` of ``agent
 nothing. Writes ``docs/leaderboard.md`` and one figure per id beside it
 (``docs/leaderboard/<EnvName>.png``).
 
-Per id (:data:`BOARDS`), one row per trigger, each from a named record:
+Per id (:data:`BOARDS`), one row per trigger, each from a named record and with the command
+that makes it:
 
-* **always** — transmit at every instant (the periodic sweep's ``every=1`` point, or a
-  ``<EnvName>_always/`` record of ``baselines.evaluate --policy always``);
-* **the paper's rule** at the paper's thresholds, and **the clock** at the best rule's rate
-  (periodic transmission every ``k`` instants, ``k`` matched to it), both from the best rule's
-  record;
-* **the best hand-designed rule** — the rule variant the validation set chose from a menu,
-  judged as the self-triggered PPO policy pinned to it (it takes the rule's actions exactly);
-* **per-instant PPO** (``<EnvName>_ppo/``) and **self-triggered PPO** (PPO free to move its
-  decisions, where such a run was judged);
-* **learned trigger (ES)** — ``<EnvName>_learned/results.json`` wherever it exists (a
-  parametric trigger family optimised by ``agents.search``).
+* **always** — transmit at every instant (a ``<EnvName>_always/`` record of
+  ``baselines.evaluate --policy always``, or the periodic sweep's ``every=1`` point);
+* **the paper's rule** at the paper's thresholds, **the clock** at the hand point's rate
+  (periodic transmission every ``k`` instants, ``k`` matched to it) and **the best
+  hand-designed rule** (``models/<EnvName>_hand.json``, a point of the family chosen on
+  validation from a menu), all three from ``<EnvName>_hand/``;
+* **per-instant PPO** (``<EnvName>_ppo/``) and **self-triggered PPO** (trained from scratch,
+  where such a run was judged);
+* **learned trigger (ES)** — the searches of ``configs/search/<problem>.yaml``
+  (:attr:`Board.learned`).
+
+The figures draw the paper's threshold sweep, the periodic sweep and the hand menu's front from
+``<EnvName>_learned_front/pareto.json`` (:attr:`Board.curves`) beside the rows.
 
 Absolute means come with 95 % intervals from :mod:`baselines.statistics`: over the scenarios
 for one run (:func:`~baselines.statistics.summarize`), over runs × scenarios for several
@@ -65,96 +68,57 @@ class Board:
     Attributes:
         env_id: the registered id.
         paper: the paper's number in the suite ("000" .. "004").
-        sweeps: folder whose ``pareto.json`` holds the paper's threshold sweep and the periodic
-            sweep on both sets (and the λ front drawn beside them).
-        best: folder of the best hand-designed rule's ``results.json`` (its paper rule and its
-            clock at the rule's rate are read there too).
-        best_label: what that rule is, and how the judged policy holds it.
-        self_triggered: folder of the self-triggered PPO run whose decisions PPO could move,
-            or ``None`` where every judged self-triggered run was pinned to a rule.
+        learned: folder of the learned trigger's ``results.json``: the searches of
+            ``configs/search/<problem>.yaml``, the configuration the report chose.
+        self_triggered: folder of a self-triggered PPO run trained from scratch, or ``None``.
         self_triggered_label: what that run is, or why there is none.
-        front_label: what the λ front of ``sweeps`` is.
+        self_triggered_command: the commands that made that run's record, where its models
+            are not shipped.
     """
 
     env_id: str
     paper: str
-    sweeps: str
-    best: str
-    best_label: str
-    self_triggered: str | None
-    self_triggered_label: str
-    front_label: str
+    learned: str
+    self_triggered: str | None = None
+    self_triggered_label: str = "none trained from scratch under the protocol yet"
+    self_triggered_command: str | None = None
 
     @property
     def name(self) -> str:
         """The id without its namespace, as records and figures are named."""
         return self.env_id.removeprefix("etsc/")
 
+    @property
+    def hand(self) -> str:
+        """Folder of the best hand point's ``results.json`` (``models/<id>_hand.json`` judged
+        by ``agents.results``: the paper's rule and the clock at the hand point's rate too)."""
+        return f"{self.name}_hand"
 
-PINNED = "; chosen on validation, held by a pinned PPO policy (5 seeds)"
-"""How the best rule's record holds it, where PPO was pinned to it."""
+    @property
+    def curves(self) -> str:
+        """Folder whose ``pareto.json`` holds the paper's threshold sweep, the periodic sweep
+        and the hand menu's points on both sets (the learned trigger's judgement against the
+        menu, ``agents.judge.pareto``)."""
+        return f"{self.name}_learned_front"
+
 
 BOARDS = (
-    Board(
-        "etsc/OrbitAttitudeTracking-v0",
-        "000",
-        "OrbitAttitudeTracking-v0_holds_selected_front",
-        "OrbitAttitudeTracking-v0_self_triggered_floor_relative_edge",
-        "eq. (21) at γ × 4 with a1, a2 = 3.1, 3.5, gating a clock of 64 instants" + PINNED,
-        None,
-        "none judged: every self-triggered run was pinned to a rule or a clock",
-        "λ front: eq. (21) at γ × 0.3 or clocks, chosen per λ on validation",
-    ),
-    Board(
-        "etsc/ClusterContainment-v0",
-        "001",
-        "ClusterContainment-v0_channel_heartbeat_selected_front",
-        "ClusterContainment-v0_self_triggered",
-        "eq. (15) at c = 0.99 for every follower" + PINNED,
-        None,
-        "none judged: every self-triggered run was pinned to a rule",
-        "λ front: eq. (15) with a heartbeat per follower, chosen per λ on validation",
-    ),
-    Board(
-        "etsc/ClusterContainmentCentral-v0",
-        "001",
-        "ClusterContainmentCentral-v0_heartbeat_selected_front",
-        "ClusterContainmentCentral-v0_self_triggered",
-        "eq. (15) at c = 0.99" + PINNED,
-        None,
-        "none judged: every self-triggered run was pinned to a rule",
-        "λ front: eq. (15) with a heartbeat per follower, chosen per λ on validation",
-    ),
-    Board(
-        "etsc/AttitudeTracking-v0",
-        "002",
-        "AttitudeTracking-v0_selected_front",
-        "AttitudeTracking-v0_self_triggered",
-        "eq. (27) at 8Ψ with a heartbeat of 384 instants" + PINNED,
-        "AttitudeTracking-v0_self_triggered_stage2",
-        "holds or eq. (27) × f from scratch, λ = 100 then 300, 3 seeds",
-        "λ front: rule with a heartbeat or clocks, chosen per λ on validation",
-    ),
+    Board("etsc/OrbitAttitudeTracking-v0", "000", "OrbitAttitudeTracking-v0_learned_large_budget"),
+    Board("etsc/ClusterContainment-v0", "001", "ClusterContainment-v0_learned"),
+    Board("etsc/ClusterContainmentCentral-v0", "001", "ClusterContainmentCentral-v0_learned"),
+    Board("etsc/AttitudeTracking-v0", "002", "AttitudeTracking-v0_learned_large_budget"),
     Board(
         "etsc/AsteroidOrbitKeeping-v0",
         "003",
-        "AsteroidOrbitKeeping-v0_self_triggered_front",
-        "AsteroidOrbitKeeping-v0_self_triggered",
-        "eq. (15) at α/16; chosen on validation, cloned into a PPO policy that kept it (5 seeds)",
+        "AsteroidOrbitKeeping-v0_learned",
         "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=1",
-        "holds or eq. (15) × f from scratch, λ = 1, 1 seed",
-        "λ front: cloned from α/16, PPO at 4 λ",
+        "holds or eq. (15) × f from scratch at λ = 1, one seed (before the protocol's five)",
+        "python -m agents.sweep --config configs/sweeps/asteroid_self_triggered_front.yaml && "
+        "python -m agents.results etsc/AsteroidOrbitKeeping-v0 "
+        "--sweep runs/sweeps/asteroid_self_triggered_front "
+        "--out docs/results/AsteroidOrbitKeeping-v0_self_triggered_scratch",
     ),
-    Board(
-        "etsc/InnerFormation-v0",
-        "004",
-        "InnerFormation-v0_error_time_selected_front",
-        "InnerFormation-v0_self_triggered_error_time",
-        "error-time rule at 6A (not the paper's: interval ∝ v^(-1/2))" + PINNED,
-        "InnerFormation-v0_self_triggered",
-        "cloned from eqs. (4)-(6) at 2Π, then PPO, 5 seeds",
-        "λ front: error-time rule or clocks, chosen per λ on validation",
-    ),
+    Board("etsc/InnerFormation-v0", "004", "InnerFormation-v0_learned_large_budget"),
 )
 """Every id's rows, in the papers' order."""
 
@@ -186,12 +150,14 @@ class Measure:
 
 @dataclass
 class Row:
-    """One leaderboard row: a trigger, what it is, its record and its measures per set."""
+    """One leaderboard row: a trigger, what it is, its record, its measures per set and the
+    command that makes the record (``None`` where there is no record)."""
 
     trigger: str
     what: str
     record: str
     sets: dict[str, Measure | None]
+    command: str | None = None
 
 
 def _load(path: Path) -> dict[str, Any]:
@@ -252,8 +218,25 @@ def _evaluate_measure(path: Path) -> Measure | None:
     return _episodes_measure([_load(path)["episodes"]]) if path.is_file() else None
 
 
+def results_command(record: dict[str, Any], folder: str) -> str:
+    """The ``agents.results`` command that writes ``record`` (a ``results.json``) into
+    ``docs/results/<folder>/``: its models, env keywords and scenario sets."""
+    parts = ["python -m agents.results", record["env"]]
+    parts += [f"--model {model}" for model in record["models"]]
+    parts += [f"--env-arg {key}={value}" for key, value in record.get("env_args", {}).items()]
+    sets = list(record["sets"])
+    if sets != ["paper", "test"]:
+        parts.append("--scenarios " + " ".join(sets))
+    return " ".join([*parts, f"--out docs/results/{folder.split('/')[0]}"])
+
+
 def _results_row(
-    records: Path, folder: str | None, trigger: str, what: str, part: str = "learned"
+    records: Path,
+    folder: str | None,
+    trigger: str,
+    what: str,
+    part: str = "learned",
+    command: str | None = None,
 ) -> Row:
     if folder is None or not (records / folder / "results.json").is_file():
         return Row(trigger, what, "—", dict.fromkeys(SETS))
@@ -263,6 +246,7 @@ def _results_row(
         what,
         f"`{folder}/`",
         {name: _record_measure(record, name, part) for name in SETS},
+        command or results_command(record, folder),
     )
 
 
@@ -271,59 +255,90 @@ def _always_row(records: Path, board: Board, sweeps: dict[str, Any]) -> Row:
     folder = f"{board.name}_always"
     if (records / folder).is_dir():
         sets = {name: _evaluate_measure(records / folder / f"{name}.json") for name in SETS}
-        return Row("always", what, f"`{folder}/`", sets)
+        command = " && ".join(
+            f"python -m baselines.evaluate {board.env_id} --policy always --scenarios {name} "
+            f"--json docs/results/{folder}/{name}.json"
+            for name in SETS
+        )
+        return Row("always", what, f"`{folder}/`", sets, command)
     every_instant = [p for p in sweeps["curves"]["periodic"] if p["args"].get("every") == 1]
     if not every_instant:
         return Row("always", what, "—", dict.fromkeys(SETS))
     sets = {name: _sweep_measure(every_instant[0], name) for name in SETS}
-    return Row("always", what + " (the clock every instant)", f"`{board.sweeps}/`", sets)
+    return Row(
+        "always",
+        what + " (the clock every instant)",
+        f"`{board.curves}/`",
+        sets,
+        f"python -m agents.judge.pareto {board.env_id} --out docs/results/{board.curves} "
+        "(its periodic sweep's every = 1)",
+    )
+
+
+def hand_label(record: dict[str, Any]) -> str:
+    """What the hand point of a ``results.json`` is: its file's ``hand`` section (the rule,
+    and how many rules the menu it was chosen from held)."""
+    hand = _load(ROOT / record["models"][0])["hand"]
+    return (
+        f"{hand['rule']}; a point of the family chosen on {hand['chosen_on']} from a menu of "
+        f"{len(hand['menu'])} rules and clocks (a tuned baseline)"
+    )
 
 
 def board_rows(records: Path, board: Board) -> list[Row]:
     """Every row of one id, in the leaderboard's order."""
-    sweeps = _load(records / board.sweeps / "pareto.json")
-    best = _load(records / board.best / "results.json")
-    every = [best["sets"][name]["models"][0]["periodic_every"] for name in SETS]
-    best_record = f"`{board.best}/`"
-    rows = [
+    sweeps = _load(records / board.curves / "pareto.json")
+    hand = _load(records / board.hand / "results.json")
+    every = [hand["sets"][name]["models"][0]["periodic_every"] for name in SETS]
+    hand_record, hand_command = f"`{board.hand}/`", results_command(hand, board.hand)
+    learned = _load(records / board.learned / "results.json")
+    return [
         _always_row(records, board, sweeps),
         Row(
             "paper's rule",
             "the paper's thresholds",
-            best_record,
-            {name: _record_measure(best, name, "paper") for name in SETS},
+            hand_record,
+            {name: _record_measure(hand, name, "paper") for name in SETS},
+            hand_command,
         ),
         Row(
             "clock",
             f"every {every[0]} (test set) and {every[1]} (paper scenario) instants: "
-            "the best rule's rate",
-            best_record,
-            {name: _record_measure(best, name, "periodic") for name in SETS},
+            "the hand point's rate",
+            hand_record,
+            {name: _record_measure(hand, name, "periodic") for name in SETS},
+            hand_command,
         ),
         Row(
-            "best hand-designed rule",
-            board.best_label,
-            best_record,
-            {name: _record_measure(best, name, "learned") for name in SETS},
+            HAND,
+            hand_label(hand),
+            hand_record,
+            {name: _record_measure(hand, name, "learned") for name in SETS},
+            hand_command,
         ),
         _results_row(records, f"{board.name}_ppo", "per-instant PPO", PPO_LABEL),
         _results_row(
-            records, board.self_triggered, "self-triggered PPO", board.self_triggered_label
+            records,
+            board.self_triggered,
+            "self-triggered PPO",
+            board.self_triggered_label,
+            command=board.self_triggered_command,
+        ),
+        _results_row(
+            records,
+            board.learned,
+            LEARNED,
+            f"the rule's parametric family searched with CMA-ES ({len(learned['models'])} "
+            "search seeds, the penalty chosen on validation)",
         ),
     ]
-    for folder in sorted(records.glob(f"{board.name}_learned*/results.json")):
-        name = folder.parent.name
-        variant = name.removeprefix(f"{board.name}_learned").strip("_").replace("_", " ")
-        trigger = LEARNED + (f", {variant})" if variant else ")")
-        seeds = len(_load(folder)["models"])
-        what = f"the rule's parametric family searched with CMA-ES ({seeds} search seeds)"
-        rows.append(_results_row(records, name, trigger, what))
-    return rows
 
 
-LEARNED = "learned trigger (ES"
-"""The start of a learned trigger's row name; a ``<EnvName>_learned_<variant>/`` record adds
-its variant (``learned trigger (ES, modulated)``)."""
+HAND = "best hand-designed rule"
+"""The row of ``models/<id>_hand.json``."""
+
+LEARNED = "learned trigger (ES)"
+"""The row of the searched family point."""
 
 
 def _number(value: float) -> str:
@@ -365,15 +380,9 @@ def _table(rows: list[Row]) -> list[str]:
     return lines
 
 
-SUMMARY_TRIGGERS = (
-    "always",
-    "clock",
-    "best hand-designed rule",
-    "per-instant PPO",
-    "self-triggered PPO",
-)
-"""The triggers of the across-id summary (with every learned trigger found), each over the ids
-whose record keeps its test episodes."""
+SUMMARY_TRIGGERS = ("always", "clock", HAND, "per-instant PPO", "self-triggered PPO", LEARNED)
+"""The triggers of the across-id summary, each over the ids whose record keeps its test
+episodes."""
 
 
 def _scenario_scores(measure: Measure, reference: Measure) -> tuple[np.ndarray, np.ndarray]:
@@ -391,8 +400,7 @@ def across_ids(boards: dict[str, list[Row]]) -> list[dict[str, Any]]:
     per-scenario ratios to the paper's rule (cost and transmissions) and the probability of a
     lower cost than the rule, with bootstrap intervals over the scenarios of all those ids."""
     summary = []
-    learned = sorted({row.trigger for rows in boards.values() for row in rows} - set(ROW_STYLES))
-    for trigger in (*SUMMARY_TRIGGERS, *learned):
+    for trigger in SUMMARY_TRIGGERS:
         costs, sents, paper_costs, paper_sents, ids = [], [], [], [], []
         for env_id, rows in boards.items():
             by_name = {row.trigger: row for row in rows}
@@ -444,25 +452,12 @@ ROW_STYLES = {
     "always": {"marker": "s", "color": "0.3", "markerfacecolor": "none", "markersize": 9},
     "paper's rule": {"marker": "o", "color": "C0", "markersize": 10},
     "clock": {"marker": "s", "color": "C1", "markersize": 9},
-    "best hand-designed rule": {"marker": "*", "color": "C3", "markersize": 16},
+    HAND: {"marker": "*", "color": "C3", "markersize": 16},
     "per-instant PPO": {"marker": "^", "color": "C4", "markersize": 10},
     "self-triggered PPO": {"marker": "v", "color": "C5", "markersize": 10},
+    LEARNED: {"marker": "D", "color": "C2", "markersize": 10},
 }
-"""Each row's marker in the figures; a learned trigger takes one of :data:`LEARNED_STYLES`."""
-
-LEARNED_STYLES = (
-    {"marker": "D", "color": "C2", "markersize": 10},
-    {"marker": "P", "color": "C9", "markersize": 11},
-    {"marker": "X", "color": "C6", "markersize": 11},
-)
-
-
-def _style(trigger: str, triggers: list[str]) -> dict[str, Any]:
-    """The marker of ``trigger`` among a figure's ``triggers``."""
-    if trigger in ROW_STYLES:
-        return ROW_STYLES[trigger]
-    learned = [name for name in triggers if name not in ROW_STYLES]
-    return LEARNED_STYLES[learned.index(trigger) % len(LEARNED_STYLES)]
+"""Each row's marker in the figures."""
 
 
 SWEEP_STYLES = {
@@ -483,19 +478,15 @@ def _curve(points: list[dict[str, Any]], name: str) -> tuple[list[float], list[f
     return [m.sent["mean"] for m in kept], [m.cost["mean"] for m in kept]
 
 
-def _front(points: list[dict[str, Any]], name: str) -> tuple[list[float], list[float]]:
-    """The λ front's points on one set, each λ the mean over its seeds."""
-    groups: dict[str, list[Measure]] = {}
-    for point in points:
-        groups.setdefault(point["policy"].split("seed=")[0], []).append(_sweep_measure(point, name))
-    pairs = sorted(
-        (
-            float(np.mean([m.sent["mean"] for m in group])),
-            float(np.mean([m.cost["mean"] for m in group])),
-        )
-        for group in groups.values()
-    )
-    return [x for x, _ in pairs], [y for _, y in pairs]
+def _envelope(points: list[dict[str, Any]], name: str) -> tuple[list[float], list[float]]:
+    """The non-dominated points of the hand menu on one set (no point of the menu sends fewer
+    transmissions at a lower cost), by transmissions."""
+    xs, ys = _curve(points, name)
+    kept: list[tuple[float, float]] = []
+    for x, y in zip(xs, ys, strict=True):
+        if not kept or y < kept[-1][1]:
+            kept.append((x, y))
+    return [x for x, _ in kept], [y for _, y in kept]
 
 
 NARROW = 0.25
@@ -514,21 +505,19 @@ def _span(values: list[float], log: bool, pad: float = 0.08) -> tuple[float, flo
     return low - margin, high + margin
 
 
-def _panel(
-    axes: plt.Axes, board: Board, rows: list[Row], sweeps: dict[str, Any], name: str
-) -> None:
-    """One set's panel: sweeps and front as lines, rows as markers; the axes span the paper's
-    sweep, the front and the rows (``always`` aside); a row outside them is drawn at the edge
-    with its numbers written beside it."""
+def _panel(axes: plt.Axes, rows: list[Row], sweeps: dict[str, Any], name: str) -> None:
+    """One set's panel: sweeps and the hand menu's front as lines, rows as markers; the axes
+    span the paper's sweep, the menu's front and the rows (``always`` aside); a row outside
+    them is drawn at the edge with its numbers written beside it."""
     curves = {
         curve: _curve(sweeps["curves"][curve], name)
         for curve in SWEEP_STYLES
         if curve in sweeps["curves"]
     }
-    if sweeps["curves"].get("learned"):
-        curves["front"] = _front(sweeps["curves"]["learned"], name)
+    if sweeps["curves"].get("hand_menu"):
+        curves["menu"] = _envelope(sweeps["curves"]["hand_menu"], name)
     measures = [(row.trigger, row.sets[name]) for row in rows if row.sets[name] is not None]
-    core_x = curves["paper"][0] + curves.get("front", ([], []))[0]
+    core_x = curves["paper"][0] + curves.get("menu", ([], []))[0]
     core_x += [m.sent["mean"] for trigger, m in measures if trigger != "always" and not m.failures]
     x_low, x_high = _span([x for x in core_x if x > 0], log=True, pad=0.25)
     inside = [
@@ -541,15 +530,16 @@ def _panel(
     log_cost = min(inside) > 0 and max(inside) > 3 * min(inside)
     y_low, y_high = _span(inside, log=log_cost)
     for curve, (xs, ys) in curves.items():
-        if curve == "front":
-            axes.plot(xs, ys, "d:", color="C7", markersize=5, label=board.front_label)
+        if curve == "menu":
+            label = "hand menu's front (every rule, clock and decision tried)"
+            axes.plot(xs, ys, "d:", color="C7", markersize=5, label=label)
         else:
             fmt, color, label = SWEEP_STYLES[curve]
             axes.plot(xs, ys, fmt, color=color, markersize=4, alpha=0.6, label=label)
     off_axes: list[str] = []
     for trigger, measure in measures:
         x, y = measure.sent["mean"], measure.cost["mean"]
-        style = _style(trigger, [row.trigger for row in rows])
+        style = ROW_STYLES[trigger]
         if x_low <= x <= x_high and y_low <= y <= y_high:
             interval = measure.cost.get("mean_ci95")
             narrow = interval is not None and interval[1] - interval[0] < NARROW * (y_high - y_low)
@@ -600,7 +590,7 @@ def _bar(summary: dict[str, Any]) -> list[list[float]] | None:
 
 def figure(board: Board, rows: list[Row], sweeps: dict[str, Any], path: Path) -> None:
     """Accuracy against transmissions on the test set (left) and the paper scenario (right):
-    the sweeps and the λ front as lines, each leaderboard row as a marker with its 95 %
+    the sweeps and the hand menu's front as lines, each leaderboard row as a marker with its 95 %
     intervals (a cost interval wider than the panel, where scenarios differ more than
     triggers, is left out), a cross over a row with failures."""
     fig, panels = plt.subplots(1, 2, figsize=(12.0, 5.2))
@@ -609,12 +599,12 @@ def figure(board: Board, rows: list[Row], sweeps: dict[str, Any], path: Path) ->
         "paper scenario (one episode; intervals over seeds)",
     )
     for axes, name, title in zip(panels, SETS, titles, strict=True):
-        _panel(axes, board, rows, sweeps, name)
+        _panel(axes, rows, sweeps, name)
         axes.set_title(title, fontsize=10)
     panels[0].set_ylabel("mean cost per step (lower is better)")
     handles, labels = panels[0].get_legend_handles_labels()
     for trigger in [row.trigger for row in rows if any(row.sets.values())]:
-        style = _style(trigger, [row.trigger for row in rows])
+        style = ROW_STYLES[trigger]
         handles.append(plt.Line2D([], [], linestyle="", **style))
         labels.append(trigger)
     handles.append(plt.Line2D([], [], marker="x", linestyle="", color="k", markersize=9))
@@ -628,22 +618,114 @@ def figure(board: Board, rows: list[Row], sweeps: dict[str, Any], path: Path) ->
 HEADER = """# Leaderboard
 
 Generated by `python -m agents.leaderboard` from the judged records under
-[`results/`](results/) alone (nothing is re-run; do not edit by hand). Each id's table gives the
-mean per-step accuracy cost (the env's `mean_cost`, lower is better) and the transmissions per
-episode, with 95 % intervals, and the failed episodes, on the 64-scenario test set and the
-paper scenario ([`protocol.md`](protocol.md)). A row over several training seeds pools them
-(rliable's stratified bootstrap over scenarios and seeds; seeds that recorded the same episodes
-count once); a sweep point keeps its `pareto.json` interval; the paper scenario is one episode
-per seed. The best hand-designed rule is a menu choice made on the validation set — a tuned
-baseline, not a learned trigger — judged as the self-triggered PPO policy started from it
-(pinned, on 003 cloned), which took exactly its actions. The report is [`results.md`](results.md).
+[`results/`](results/) alone (nothing is re-run; do not edit by hand); each id's commands below
+its table remake its records. Each table gives the mean per-step accuracy cost (the env's
+`mean_cost`, lower is better; its formula and units are on the env's page) and the
+transmissions per episode, with 95 % intervals, and the failed episodes, on the 64-scenario
+test set and the paper scenario ([`protocol.md`](protocol.md)). A row over several seeds pools
+them (rliable's stratified bootstrap over scenarios and seeds); the paper scenario is one
+episode per seed. The best hand-designed rule is a point of the paper's trigger family chosen
+on the validation set from a menu of rule variants and clocks (`models/<id>_hand.json`) — a
+tuned baseline, not a learned trigger. The report is [`results.md`](results.md).
 """
 
 
-def render(records: Path, figures: Path | None, link: str) -> str:
-    """The leaderboard's Markdown (``link`` is the figures' folder as the page refers to it);
-    draws the figures into ``figures`` unless it is ``None``."""
-    boards = {board.env_id: board_rows(records, board) for board in BOARDS}
+RL_TRIGGERS = ("per-instant PPO", "self-triggered PPO")
+"""The reinforcement-learning rows, of which the README shows the best."""
+
+README = ROOT / "README.md"
+README_MARKERS = ("<!-- leaderboard: agents.leaderboard writes this table -->", "<!-- end -->")
+"""The README's summary table lies between these lines."""
+
+
+def best_rl_row(rows: list[Row]) -> Row | None:
+    """The RL row of an id the README shows: among those with a test record and no failed
+    test episode, the fewest transmissions at a cost within ×1.05 of the paper's rule's
+    (the suite's goal); where none is within it, the cheapest; ``None`` where none has a
+    record without failures."""
+    by_name = {row.trigger: row for row in rows}
+    paper = by_name["paper's rule"].sets["test"]
+    judged = [
+        by_name[name]
+        for name in RL_TRIGGERS
+        if (measure := by_name[name].sets["test"]) is not None and not measure.failures
+    ]
+    if paper is None or not judged:
+        return None
+    limit = 1.05 * paper.cost["mean"]
+
+    def test_measure(row: Row) -> Measure:
+        measure = row.sets["test"]
+        assert measure is not None
+        return measure
+
+    within = [row for row in judged if test_measure(row).cost["mean"] <= limit]
+    if within:
+        return min(within, key=lambda row: test_measure(row).sent["mean"])
+    return min(judged, key=lambda row: test_measure(row).cost["mean"])
+
+
+def _pair(measure: Measure | None) -> str:
+    if measure is None:
+        return "—"
+    failed = f" ({measure.failures}/{measure.episodes} failed)" if measure.failures else ""
+    return f"{_number(measure.cost['mean'])} / {_number(measure.sent['mean'])}{failed}"
+
+
+def readme_table(boards: dict[str, list[Row]]) -> list[str]:
+    """The README's table: per id, the test-set mean cost / transmissions of the paper's rule,
+    the best hand point, the learned trigger and the best RL agent (:func:`best_rl_row`)."""
+    lines = [
+        README_MARKERS[0],
+        "| id | paper's rule | best hand point | learned trigger (ES) | best RL agent |",
+        "|---|---|---|---|---|",
+    ]
+    for board in BOARDS:
+        by_name = {row.trigger: row for row in boards[board.env_id]}
+        rl = best_rl_row(boards[board.env_id])
+        rl_cell = "—" if rl is None else f"{_pair(rl.sets['test'])}, {rl.trigger}"
+        cells = [
+            f"[{SHORT_NAMES[board.env_id]}](docs/envs/{board.name}.md)",
+            _pair(by_name["paper's rule"].sets["test"]),
+            _pair(by_name[HAND].sets["test"]),
+            _pair(by_name[LEARNED].sets["test"]),
+            rl_cell,
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    return [*lines, README_MARKERS[1]]
+
+
+def with_readme_table(readme: str, table: list[str]) -> str:
+    """``readme`` with the text between :data:`README_MARKERS` replaced by ``table``."""
+    start, end = README_MARKERS
+    if start not in readme or end not in readme.split(start, 1)[1]:
+        raise ValueError(f"README.md: no table between {start!r} and {end!r}")
+    before, rest = readme.split(start, 1)
+    after = rest.split(end, 1)[1]
+    return before + "\n".join(table) + after
+
+
+def _commands(rows: list[Row]) -> list[str]:
+    """Each record's command, once, with the rows it makes."""
+    commands: dict[str, list[str]] = {}
+    for row in rows:
+        if row.command is not None:
+            commands.setdefault(row.command, []).append(row.trigger)
+    return [f"- {', '.join(triggers)}: `{command}`" for command, triggers in commands.items()]
+
+
+def all_rows(records: Path) -> dict[str, list[Row]]:
+    """Every id's rows."""
+    return {board.env_id: board_rows(records, board) for board in BOARDS}
+
+
+def render(
+    records: Path, figures: Path | None, link: str, boards: dict[str, list[Row]] | None = None
+) -> str:
+    """The leaderboard's Markdown (``link`` is the figures' folder as the page refers to it)
+    of ``boards`` (default every id's rows from ``records``); draws the figures into
+    ``figures`` unless it is ``None``."""
+    boards = all_rows(records) if boards is None else boards
     lines = [HEADER, "## Across ids (test set)", ""]
     lines += [
         "Every test scenario of every id with the trigger's record is one task; a trigger's "
@@ -660,10 +742,11 @@ def render(records: Path, figures: Path | None, link: str) -> str:
     for board in BOARDS:
         rows = boards[board.env_id]
         lines += [f"## `{board.env_id}` (paper {board.paper})", "", *_table(rows), ""]
+        lines += ["Commands:", "", *_commands(rows), ""]
         image = f"{link}/{board.name}.png"
         lines += [f"![{board.env_id}: cost against transmissions]({image})", ""]
         if figures is not None:
-            sweeps = _load(records / board.sweeps / "pareto.json")
+            sweeps = _load(records / board.curves / "pareto.json")
             figure(board, rows, sweeps, figures / f"{board.name}.png")
     return "\n".join(lines)
 
@@ -671,7 +754,8 @@ def render(records: Path, figures: Path | None, link: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m agents.leaderboard",
-        description="docs/leaderboard.md and its figures from the judged records",
+        description="docs/leaderboard.md and its figures from the judged records (and, from "
+        "the shipped records, the README's table)",
     )
     parser.add_argument("--records", type=Path, default=RECORDS, help="the records' folder")
     parser.add_argument(
@@ -681,9 +765,14 @@ def main(argv: list[str] | None = None) -> int:
     if not args.records.is_dir():
         parser.error(f"--records must be a folder of judged records, got {args.records}")
     figures = args.out.with_suffix("")
-    text = render(args.records, figures, figures.name)
+    boards = all_rows(args.records)
+    text = render(args.records, figures, figures.name, boards)
     atomic_write_text(args.out, text)
     print(f"wrote {args.out} and {len(BOARDS)} figures in {figures}/", file=sys.stderr)
+    if args.records.resolve() == RECORDS:
+        readme = with_readme_table(README.read_text(encoding="utf-8"), readme_table(boards))
+        atomic_write_text(README, readme)
+        print(f"wrote the table of {README}", file=sys.stderr)
     return 0
 
 
