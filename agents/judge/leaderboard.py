@@ -469,8 +469,13 @@ SWEEP_STYLES = {
 
 
 def _curve(points: list[dict[str, Any]], name: str) -> tuple[list[float], list[float]]:
-    """A sweep's points on one set without those that failed, by transmissions."""
-    measures = [_sweep_measure(point, name) for point in points]
+    """A sweep's points on one set without those that failed, by transmissions (a point judged
+    without the paper scenario is left out of its panel)."""
+    measures = [
+        _sweep_measure(point, name)
+        for point in points
+        if name != "paper" or point.get("paper_scenario") is not None
+    ]
     kept = sorted(
         (m for m in measures if m.sent["mean"] > 0 and not m.failures),
         key=lambda m: m.sent["mean"],
