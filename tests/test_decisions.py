@@ -23,6 +23,7 @@ from etsc_envs.triggers import PeriodicPolicy
 from etsc_envs.triggers.asteroid import AsteroidShield
 from etsc_envs.triggers.inner_formation import InnerFormationShield, default_error_time_thresholds
 from tests.rule_sets import (
+    BASE_CONFIG,
     caps_of,
     deployed_policy,
     factors_of,
@@ -448,14 +449,9 @@ ERROR_TIME = {"kind": "trigger", "rule": "error_time"}
 def test_training_config_checks_the_decisions(tmp_path, changes, message):
     from agents.train.config import config_from_dict
 
-    config = {
-        "env_id": FORMATION,
-        "env_kwargs": {"horizon_s": 0.1},
-        "algorithm": "PPO",
-        "policy": "MlpPolicy",
-        "total_timesteps": 64,
-        "out_dir": str(tmp_path / "run"),
-    }
+    plain = {key: value for key, value in BASE_CONFIG.items() if key != "decisions"}
+    config = plain | {"env_id": FORMATION, "env_kwargs": {"horizon_s": 0.1}}
+    config["out_dir"] = str(tmp_path / "run")
     with pytest.raises(ValueError, match=message):
         config_from_dict({**config, **changes})
 
