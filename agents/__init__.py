@@ -2,8 +2,8 @@
 
 - :mod:`agents.train`: Stable-Baselines3 training of transmit/hold and self-triggered policies
   (``python -m agents.train --config configs/train/NAME.yaml``; keys in
-  :mod:`agents.train.config`), with imitation starts, elapsed-time discounting, the
-  validation callback and the vector-env adapter.
+  :mod:`agents.train.config`), with elapsed-time discounting, the validation callback and
+  the vector-env adapter.
 - :mod:`agents.search`: CMA-ES over a paper's parametric trigger family
   (``python -m agents.search --config configs/search/NAME.yaml``).
 - :mod:`agents.sweep`: fronts over penalties and seeds on Ray Tune or in worker processes

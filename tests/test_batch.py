@@ -8,13 +8,15 @@ import math
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import pytest
 
 from agents.train.validation_callback import deployment
 from baselines.batch import run_batch, run_batch_in_processes
 from baselines.policy_specs import episode_setup
-from etsc_envs.decisions import SelfTriggeredPolicy, decision_set_v1
+from etsc_envs.decisions import SelfTriggeredPolicy
+from tests.rule_sets import rule_set, rule_wrapper
 
 SHORT_HORIZONS = {
     "etsc/AttitudeTracking-v0": 2.0,
@@ -167,12 +169,12 @@ def assert_same_episode(single: dict[str, Any], batch: dict[str, Any]) -> None:
 @pytest.mark.parametrize(
     ("env_id", "decision_keywords"),
     [
-        ("etsc/AttitudeTracking-v0", {"max_exponent": 6, "rule_cap": 48, "rule_heartbeat": True}),
+        ("etsc/AttitudeTracking-v0", {"max_exponent": 6, "cap": 48, "send_first": True}),
         ("etsc/InnerFormation-v0", {"max_exponent": 6, "shield_multiple": 2.0}),
         ("etsc/InnerFormation-v0", {"max_exponent": 5, "rule": "error_time"}),
-        ("etsc/OrbitAttitudeTracking-v0", {"max_exponent": 6, "rule_floor": 8}),
+        ("etsc/OrbitAttitudeTracking-v0", {"max_exponent": 6, "floor": 8}),
         ("etsc/AsteroidOrbitKeeping-v0", {"max_exponent": 6, "shield_multiple": 1.0}),
-        ("etsc/ClusterContainmentCentral-v0", {"max_exponent": 8}),
+        ("etsc/ClusterContainmentCentral-v0", {"max_exponent": 8, "factors": (0.5, 1.0, 1.5)}),
     ],
 )
 def test_self_triggered_decisions_run_decision_by_decision_as_instant_by_instant(
@@ -182,10 +184,7 @@ def test_self_triggered_decisions_run_decision_by_decision_as_instant_by_instant
     decision: the episodes of the per-instant deployment, every action of the set taken."""
     env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
     setup = episode_setup(env_id, env_args)
-    unwrapped = setup.env.unwrapped
-    decisions = decision_set_v1(
-        env_id, sampling_period_s=float(unwrapped.params.sampling_period_s), **decision_keywords
-    )
+    decisions = rule_set(env_id, **decision_keywords)
     policy = SelfTriggeredPolicy(
         ScriptedDecisions(decisions.action_space.n), *deployment(setup, decisions)
     )
@@ -197,10 +196,16 @@ def test_self_triggered_decisions_run_decision_by_decision_as_instant_by_instant
         assert_same_episode(one, other)
 
 
-def test_a_shipped_self_triggered_model_runs_decision_by_decision() -> None:
-    pytest.importorskip("stable_baselines3")
+def test_a_saved_self_triggered_model_runs_decision_by_decision(tmp_path: Path) -> None:
+    """An SB3 model of self-triggered decisions saved with its set (``sb3:``) runs the same
+    episodes in the batch as one by one."""
+    stable_baselines3 = pytest.importorskip("stable_baselines3")
     env_id = "etsc/AttitudeTracking-v0"
-    spec = f"sb3:{MODEL.with_name('AttitudeTracking-v0_self_triggered.zip')}"
+    wrapper = rule_wrapper(gym.make(env_id), max_exponent=6)
+    model = stable_baselines3.PPO("MlpPolicy", wrapper, device="cpu", seed=0)
+    model.save(tmp_path / "model.zip")
+    wrapper.decisions.save(tmp_path / "model.zip")
+    spec = f"sb3:{tmp_path / 'model.zip'}"
     env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
     single = single_records(env_id, spec, {}, env_args)
     batch = batch_records(env_id, spec, {}, env_args)

@@ -15,15 +15,15 @@ import pytest
 import etsc_envs  # noqa: F401  (registers the ids)
 from baselines.episodes import run_episode
 from baselines.policy_specs import episode_setup
-from etsc_envs.decisions import DecisionSet, decision_set_v1
+from etsc_envs.decisions import DecisionSet
 from etsc_envs.triggers import ClusterContainmentTrigger
 from etsc_envs.triggers.base import (
     channel_heartbeat_trigger_class,
     instants_seconds,
     timed_rule_class,
 )
+from tests.rule_sets import deployed_policy, rule_set, rule_wrapper
 from tests.test_decisions import RecordedActions, ScriptedModel
-from tests.v1_decisions import deployed_policy, v1_wrapper
 
 CENTRAL = "etsc/ClusterContainmentCentral-v0"
 HORIZON_S = 20.0
@@ -93,9 +93,9 @@ def test_the_decision_runs_the_trigger_in_compiled_intervals_and_deployed():
     """Always choosing "paper x1, channel heartbeat 150" (with a plain rule action beside it)
     updates as the reference does, stepped through compiled intervals and deployed as a
     transmit/hold policy one instant at a time."""
-    kwargs = {"max_exponent": 6, "factors": (0.5, 1.0), "rule_channel_heartbeat": [None, 150]}
+    kwargs = {"max_exponent": 6, "factors": (0.5, 1.0), "channel_heartbeat": [None, 150]}
     base = central_env()
-    wrapper = v1_wrapper(base, **kwargs)
+    wrapper = rule_wrapper(base, **kwargs)
     labels = [wrapper.decisions.label(len(wrapper.decisions.hold_indices) + i) for i in range(2)]
     assert labels == ["paper x0.5", "paper x1, channel heartbeat 150"]
     action = wrapper.decisions.action(labels[1])
@@ -116,21 +116,16 @@ def test_the_decision_runs_the_trigger_in_compiled_intervals_and_deployed():
 
 
 @pytest.mark.parametrize(
-    ("kwargs", "message"),
+    ("heartbeat", "message"),
     [
-        ({"rule_channel_heartbeat": 0}, "rule_channel_heartbeat must be an integer"),
-        ({"rule_channel_heartbeat": 2.5}, "rule_channel_heartbeat must be an integer"),
-        ({"rule_channel_heartbeat": True}, "rule_channel_heartbeat must be an integer"),
-        ({"rule_channel_heartbeat": 2**20 + 1}, "rule_channel_heartbeat must be an integer"),
-        ({"rule_channel_heartbeat": [8]}, "one heartbeat per factor"),
-        ({"rule_channel_heartbeat": [8, 0]}, "rule_channel_heartbeat must be an integer"),
-        ({"rule_channel_heartbeat": 8, "rule_floor": 4}, "one of the two"),
+        (0.0, "heartbeat_instants must be >= 1"),
+        (-1.0, "heartbeat_instants must be a number >= 0"),
     ],
 )
-def test_a_decision_set_refuses_a_bad_channel_heartbeat(kwargs, message):
-    arguments = {"env_id": CENTRAL, "factors": (0.5, 1.0), "sampling_period_s": 0.01, **kwargs}
-    with pytest.raises(ValueError, match=message):
-        decision_set_v1(**arguments)
+def test_a_decision_set_refuses_a_bad_channel_heartbeat(heartbeat, message):
+    action = {"kind": "trigger", "point": {"heartbeat_instants": heartbeat}}
+    with pytest.raises(ValueError, match=rf"actions\[0\]: .*{message}"):
+        DecisionSet.from_json({"actions": [action]}, CENTRAL)
 
 
 def test_a_channel_heartbeat_trigger_names_its_bad_arguments():
@@ -145,9 +140,7 @@ def test_a_channel_heartbeat_trigger_names_its_bad_arguments():
 
 
 def test_channel_heartbeats_survive_a_save_and_a_load(tmp_path):
-    decisions = decision_set_v1(
-        CENTRAL, factors=(0.5, 1.0), rule_channel_heartbeat=[None, 256], sampling_period_s=0.01
-    )
+    decisions = rule_set(CENTRAL, factors=(0.5, 1.0), channel_heartbeat=[None, 256])
     decisions.save(tmp_path / "model.zip")
     loaded = DecisionSet.load(tmp_path / "model.zip")
     beats = [loaded.actions[i].point.heartbeat_instants for i in loaded.trigger_indices]

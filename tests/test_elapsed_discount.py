@@ -16,7 +16,7 @@ from agents.train.elapsed_discount import (
     ElapsedStepsCallback,
     MaskableElapsedRolloutBuffer,
 )
-from tests.v1_decisions import v1_wrapper
+from tests.rule_sets import rule_wrapper
 
 SIZE, ENVS, GAMMA = 6, 2, 0.9
 
@@ -64,7 +64,7 @@ def test_returns_discount_by_elapsed_instants():
 
 
 def test_training_passes_the_elapsed_steps_to_the_buffer():
-    env = v1_wrapper(
+    env = rule_wrapper(
         gym.make("etsc/InnerFormation-v0", horizon_s=0.1), max_exponent=3, shield_multiple=2.0
     )
     model = MaskablePPO(
@@ -83,7 +83,7 @@ def test_training_passes_the_elapsed_steps_to_the_buffer():
 
 
 def test_callback_needs_an_elapsed_buffer():
-    env = v1_wrapper(gym.make("etsc/InnerFormation-v0", horizon_s=0.1), max_exponent=3)
+    env = rule_wrapper(gym.make("etsc/InnerFormation-v0", horizon_s=0.1), max_exponent=3)
     model = MaskablePPO("MlpPolicy", env, n_steps=32, batch_size=32, device="cpu")
     with pytest.raises(ValueError, match="rollout_buffer_class"):
         model.learn(total_timesteps=32, callback=ElapsedStepsCallback())

@@ -14,7 +14,7 @@ from baselines.episodes import run_parallel_episode
 from etsc_envs.decisions import FollowerDecisionEnv
 from etsc_envs.papers import paper_of
 from etsc_envs.triggers.base import HeartbeatPolicy
-from tests.v1_decisions import deployed_policy, v1_follower
+from tests.rule_sets import deployed_policy, rule_follower
 
 CLUSTER = "etsc/ClusterContainment-v0"
 HORIZON_S = 3.0
@@ -37,7 +37,7 @@ class ScriptedSharedModel:
 
 
 def follower_env(horizon_s: float = HORIZON_S, **kwargs) -> FollowerDecisionEnv:
-    return v1_follower(CLUSTER, {"horizon_s": horizon_s}, **{**DECISIONS, **kwargs})
+    return rule_follower(CLUSTER, {"horizon_s": horizon_s}, **{**DECISIONS, **kwargs})
 
 
 @pytest.mark.parametrize("seed", [0, 5])
@@ -109,24 +109,23 @@ def assert_same_updates(info: dict, record: dict) -> None:
         assert info["episode_metrics"]["agents"][name]["transmissions"] == agent["transmissions"]
 
 
-def test_teammates_take_the_fixed_decision_until_they_follow_a_model():
-    """Before ``follow_model`` every teammate takes ``teammate_decision``: with the learner
-    taking it too, each follower updates as eq. (15)'s rule at that c does alone (20 s: the
-    rule first fires after a few seconds)."""
-    env = follower_env(horizon_s=20.0, teammate_decision="paper x1.5")
-    info = episode_info(env, env.decisions.action("paper x1.5"), seed=2)
-    record = rule_alone(20.0, seed=2, c=0.9)  # 1.5 x the paper's c = 0.6
+def test_teammates_take_the_rule_until_they_follow_a_model():
+    """Before ``follow_model`` every teammate takes the rule at its own thresholds (the first
+    trigger action at factor 1): with the learner taking it too, each follower updates as eq.
+    (15)'s rule at the paper's c does alone (20 s: the rule first fires after a few seconds)."""
+    env = follower_env(horizon_s=20.0, factors=(1.5, 1.0))
+    assert env.decisions.label(env.teammates.model.action) == "paper x1"
+    info = episode_info(env, env.decisions.action("paper x1"), seed=2)
+    record = rule_alone(20.0, seed=2, c=0.6)  # the paper's c
     assert record["transmissions"] > 0
     assert_same_updates(info, record)
 
 
 def test_a_heartbeat_per_factor_is_each_followers_rule_with_its_own_heartbeat():
-    """A set pairing each factor with its own heartbeat (``rule_cap`` a list): the teammates'
+    """A set pairing each factor with its own heartbeat (``cap`` a list): the teammates'
     default decision is the paper's rule with its heartbeat, and with the learner taking it
     too each follower updates as eq. (15)'s rule with a heartbeat of its own does alone."""
-    env = follower_env(
-        horizon_s=20.0, factors=(1.0, 1.5), rule_cap=[256, 1024], rule_heartbeat=True
-    )
+    env = follower_env(horizon_s=20.0, factors=(1.0, 1.5), cap=[256, 1024], send_first=True)
     assert env.decisions.label(env.teammates.model.action) == "paper x1, heartbeat 256"
     info = episode_info(env, env.teammates.model.action, seed=2)
     record = rule_alone(20.0, seed=2, heartbeat=256)
@@ -144,11 +143,9 @@ def test_follower_env_passes_the_gymnasium_and_sb3_env_checkers():
 
 def test_bad_arguments_name_themselves():
     with pytest.raises(ValueError, match="env_id: 'etsc/ClusterContainmentCentral-v0'"):
-        v1_follower("etsc/ClusterContainmentCentral-v0")
+        rule_follower("etsc/ClusterContainmentCentral-v0", factors=(1.0,))
     with pytest.raises(ValueError, match="gamma"):
         follower_env(gamma=1.5)
-    with pytest.raises(ValueError, match="'paper x9' is not a decision"):
-        follower_env(teammate_decision="paper x9")
     env = follower_env()
     with pytest.raises(gym.error.ResetNeeded):
         env.step(0)

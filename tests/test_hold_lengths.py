@@ -1,7 +1,7 @@
-"""A decision set's own hold lengths (``holds``): holds of any length, such as the clocks
-every 5, 10 and 20 instants of a periodic sweep, in place of 1, 2, 4, ..., 2^k. Each hold is
-its clock, its stand-alone form is that clock, the longest hold caps the rule's intervals,
-and the lengths survive a save, a load and a training config; bad lists name ``holds``."""
+"""A decision set's own hold lengths: holds of any length, such as the clocks every 5, 10 and
+20 instants of a periodic sweep, in place of 1, 2, 4, ..., 2^k. Each hold is its clock, the
+longest hold caps the rule's intervals, and the lengths survive a save, a load and a training
+config."""
 
 from __future__ import annotations
 
@@ -9,10 +9,9 @@ import numpy as np
 import pytest
 
 from agents.train.config import config_from_dict
-from agents.train.decision_selection import stand_alone_spec
-from etsc_envs.decisions import DecisionSet, decision_set_v1
+from etsc_envs.decisions import DecisionSet
 from etsc_envs.triggers import PeriodicPolicy
-from tests.test_decision_selection import BASE_CONFIG
+from tests.rule_sets import BASE_CONFIG, rule_set
 from tests.test_decisions import (
     ATTITUDE,
     ScriptedModel,
@@ -26,16 +25,12 @@ HOLDS = (2, 5, 10, 20)
 
 
 def test_the_holds_are_the_actions_and_the_rule_comes_after_them():
-    decisions = decision_set_v1(ATTITUDE, factors=(1.0, 4.0), holds=list(HOLDS))
+    decisions = rule_set(ATTITUDE, factors=(1.0, 4.0), holds=list(HOLDS))
     assert tuple(decisions.actions[i].instants for i in decisions.hold_indices) == HOLDS
     assert len(decisions.hold_indices) == 4 and decisions.action_space.n == 6
     labels = [decisions.label(action) for action in range(6)]
     assert labels == ["hold 2", "hold 5", "hold 10", "hold 20", "paper x1", "paper x4"]
     assert tuple(decisions.actions[i].cap for i in decisions.trigger_indices) == (20, 20)
-    assert stand_alone_spec(decisions, decisions.action("hold 10")) == (
-        "periodic",
-        {"every": 10},
-    )
 
 
 @pytest.mark.parametrize("hold", [5, 10])
@@ -50,7 +45,7 @@ def test_a_hold_of_any_length_is_its_clock(hold):
 
 
 def test_the_holds_survive_a_save_a_load_and_a_config(tmp_path):
-    decisions = decision_set_v1(ATTITUDE, factors=(1.0,), holds=HOLDS)
+    decisions = rule_set(ATTITUDE, factors=(1.0,), holds=HOLDS)
     decisions.save(tmp_path / "model.zip")
     assert DecisionSet.load(tmp_path / "model.zip") == decisions
     config = {**BASE_CONFIG, "out_dir": str(tmp_path / "run")}
@@ -58,9 +53,3 @@ def test_the_holds_survive_a_save_a_load_and_a_config(tmp_path):
     config["decisions"] = {"actions": [*holds, {"kind": "trigger", "cap": HOLDS[-1]}]}
     config = config_from_dict(config)
     assert [action["instants"] for action in config.decisions["actions"][:4]] == list(HOLDS)
-
-
-@pytest.mark.parametrize("holds", [[], [0, 5], [5, 2], [2, 2], [2.5], "10", [True]])
-def test_bad_holds_name_themselves(holds):
-    with pytest.raises(ValueError, match="holds must be a non-empty ascending list"):
-        decision_set_v1(ATTITUDE, holds=holds)

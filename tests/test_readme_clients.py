@@ -44,7 +44,12 @@ def test_the_pettingzoo_example_builds_both_forms_from_the_registry():
 
 @pytest.fixture
 def ray_session():
-    ray = pytest.importorskip("ray")
+    pytest.importorskip(
+        "ray.rllib",
+        reason="Ray RLlib: the clients extra is not installed (pip install -e '.[clients]')",
+    )
+    import ray
+
     yield
     ray.shutdown()
 

@@ -12,11 +12,11 @@ import pytest
 import etsc_envs  # noqa: F401  (registers the ids)
 from baselines.episodes import run_episode
 from baselines.policy_specs import make_policy
-from etsc_envs.decisions import DecisionSet, decision_set_v1
+from etsc_envs.decisions import DecisionSet
 from etsc_envs.triggers import OrbitAttitudeTrigger
 from etsc_envs.triggers.base import floored_trigger_class, instants_seconds
+from tests.rule_sets import rule_set, rule_wrapper
 from tests.test_decisions import RecordedActions
-from tests.v1_decisions import v1_wrapper
 
 ORBIT = "etsc/OrbitAttitudeTracking-v0"
 FORMATION = "etsc/InnerFormation-v0"
@@ -71,16 +71,16 @@ def test_a_floored_rule_is_the_clock_where_the_rule_always_fires():
     np.testing.assert_array_equal(np.diff(instants), 32)
 
 
-@pytest.mark.parametrize("rule_floor", [48, [16, 48], (48, 16)])
-def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions(rule_floor):
+@pytest.mark.parametrize("floor", [48, [16, 48], (48, 16)])
+def test_the_floor_decision_is_the_floored_rule_sending_at_its_decisions(floor):
     """Always choosing "paper x4, floor 48" (the set's one floor, or the floor paired with x4)
     transmits at the decision instant and then exactly where the stand-alone floored rule does
     (through compiled intervals)."""
-    kwargs = {"max_exponent": 8, "factors": (1.0, 4.0), "rule_floor": rule_floor}
+    kwargs = {"max_exponent": 8, "factors": (1.0, 4.0), "floor": floor}
     base = RecordedActions(gym.make(ORBIT, horizon_s=HORIZON_S, randomize=True))
-    wrapper = v1_wrapper(base, **kwargs)
+    wrapper = rule_wrapper(base, **kwargs)
     label = "paper x4, floor 48"
-    if rule_floor == (48, 16):
+    if floor == (48, 16):
         with pytest.raises(ValueError, match=label):
             wrapper.decisions.action(label)
         return
@@ -112,31 +112,26 @@ def test_the_command_line_refuses_a_bad_floor(arguments, message):
 
 
 @pytest.mark.parametrize(
-    ("kwargs", "message"),
+    ("action", "message"),
     [
-        ({"rule_floor": 0}, "rule_floor must be an integer"),
-        ({"rule_floor": 2.5}, "rule_floor must be an integer"),
-        ({"rule_floor": 64, "max_exponent": 5}, r"rule_floor \(64\) must be at most"),
-        ({"factors": (1.0, 4.0), "rule_floor": [2]}, "one floor per factor"),
-        ({"factors": (1.0, 4.0), "rule_floor": [2, 0]}, "rule_floor must be an integer"),
-        ({"factors": (1.0, 4.0), "rule_floor": [2, None]}, "rule_floor must be an integer"),
-        ({"env_id": FORMATION, "rule_floor": 8, "shield_multiple": 2.0}, "shield_multiple"),
+        ({"point": {"floor_instants": -1.0}}, "floor_instants must be a number >= 0"),
     ],
 )
-def test_a_decision_set_refuses_a_bad_floor(kwargs, message):
-    arguments = {"env_id": ORBIT, "sampling_period_s": SAMPLING_PERIOD_S, **kwargs}
-    with pytest.raises(ValueError, match=message):
-        decision_set_v1(**arguments)
+def test_a_decision_set_refuses_a_bad_floor(action, message):
+    block = {"actions": [{"kind": "hold", "instants": 1}, {"kind": "trigger", **action}]}
+    with pytest.raises(ValueError, match=rf"actions\[1\]: .*{message}"):
+        DecisionSet.from_json(block, ORBIT)
+
+
+def test_a_shielded_set_refuses_a_floored_action():
+    with pytest.raises(ValueError, match="shield_multiple: the shield bounds"):
+        rule_set(FORMATION, factors=(1.0,), floor=8, shield_multiple=2.0)
 
 
 def test_the_floor_names_its_actions_and_bad_floors_name_themselves():
-    decisions = decision_set_v1(
-        ORBIT, factors=(4.0,), rule_floor=64, sampling_period_s=SAMPLING_PERIOD_S
-    )
+    decisions = rule_set(ORBIT, factors=(4.0,), floor=64)
     assert decisions.label(len(decisions.hold_indices)) == "paper x4, floor 64"
-    paired = decision_set_v1(
-        ORBIT, factors=(0.3, 1.0), rule_floor=[2, 8], sampling_period_s=SAMPLING_PERIOD_S
-    )
+    paired = rule_set(ORBIT, factors=(0.3, 1.0), floor=[2, 8])
     labels = [paired.label(len(paired.hold_indices) + index) for index in range(2)]
     assert labels == ["paper x0.3, floor 2", "paper x1, floor 8"]
     env = gym.make(ORBIT, horizon_s=0.05)
@@ -164,9 +159,7 @@ class ObservationLog:
 
 
 def test_floors_per_factor_survive_a_save_and_a_load(tmp_path):
-    decisions = decision_set_v1(
-        ORBIT, factors=(0.3, 1.0), rule_floor=[2, 8], sampling_period_s=SAMPLING_PERIOD_S
-    )
+    decisions = rule_set(ORBIT, factors=(0.3, 1.0), floor=[2, 8])
     decisions.save(tmp_path / "model.zip")
     loaded = DecisionSet.load(tmp_path / "model.zip")
     floors = [loaded.actions[i].point.floor_instants for i in loaded.trigger_indices]

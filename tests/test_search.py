@@ -177,7 +177,9 @@ def test_shipped_search_configs_start_where_they_say() -> None:
 def test_process_and_ray_evaluators_score_alike(tmp_path: Path) -> None:
     """One tiny real search (002, 0.2-s training episodes) gives the same records through
     worker processes and through a local Ray."""
-    pytest.importorskip("ray")
+    pytest.importorskip(
+        "ray", reason="Ray: the sweep extra is not installed (pip install -e '.[sweep]')"
+    )
     config = _config(generations=2, population=2, scenarios=1, horizon_s=0.2, validate_every=1)
     logs = []
     for name, evaluator in (("processes", Evaluator(1, None)), ("ray", Evaluator(None, None))):

@@ -19,7 +19,9 @@ import pytest
 import yaml
 
 pytest.importorskip("stable_baselines3")
-pytest.importorskip("ray.tune")
+pytest.importorskip(
+    "ray.tune", reason="Ray Tune: the sweep extra is not installed (pip install -e '.[sweep]')"
+)
 
 from agents.sweep.runner import main
 from tests.sweep_fixtures import tiny_sweep
@@ -190,6 +192,9 @@ def test_a_bad_sweep_config_exits_with_one_line(tmp_path: Path, capsys) -> None:
 
 
 def test_a_search_runs_under_asha_and_optuna_to_saved_models(tmp_path: Path) -> None:
+    pytest.importorskip(
+        "optuna", reason="Optuna: the sweep extra is not installed (pip install -e '.[sweep]')"
+    )
     search = {
         "hyperparameters.learning_rate": {"loguniform": [1.0e-4, 1.0e-3]},
         "env_kwargs.transmission_penalty": {"choice": [30.0, 100.0]},

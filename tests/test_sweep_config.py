@@ -162,20 +162,16 @@ def test_a_shipped_front_crosses_penalties_with_three_seeds(path: Path) -> None:
     assert Path(config.results_dir).parts[-3:-1] == ("runs", "sweeps")
 
 
-def test_every_id_ships_a_front_of_four_penalties_with_three_seeds() -> None:
-    """The shipped fronts are of the suite's ids, and each id has one crossing at least four
-    penalties with three seeds (the others may refine it)."""
-    env_ids, wide = set(), set()
-    for path in SHIPPED_FRONTS:
-        config = load_sweep_config(path)
-        env_ids.add(config.base["env_id"])
-        if len(_penalties(config)) >= 4 and len(config.grid["seed"]) >= 3:
-            wide.add(config.base["env_id"])
+def test_the_shipped_fronts_are_of_the_suites_ids() -> None:
+    """Each shipped front trains or searches an id of the suite (one front per id and method
+    at most: no two shipped fronts share a base config)."""
     import etsc_envs
 
     every_id = set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
-    assert env_ids == every_id
-    assert wide == every_id
+    configs = [load_sweep_config(path) for path in SHIPPED_FRONTS]
+    assert configs and {config.base["env_id"] for config in configs} <= every_id
+    bases = [yaml.safe_load(path.read_text())["base"] for path in SHIPPED_FRONTS]
+    assert len(set(bases)) == len(bases)
 
 
 def test_the_package_and_the_tools_do_not_import_ray() -> None:
@@ -216,17 +212,14 @@ def test_model_paths_are_made_absolute_for_trials_that_run_elsewhere(
     assert config.results_dir == str(tmp_path / "out")
 
 
-def test_a_selection_cache_folder_is_made_absolute_for_trials_that_run_elsewhere(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """Every trial of a front shares the candidates' validation runs through one folder,
-    whichever folder the trial runs in."""
-    monkeypatch.chdir(tmp_path)
-    base = ROOT / "configs" / "train" / "attitude_tracking_self_triggered_selected.yaml"
-    raw = {**sweep(tmp_path, grid={"seed": [1]}, results_dir="out"), "base": str(base)}
-    raw["overrides"] = {"start_from.selection_cache": "cache"}
-    config = sweep_config_from_dict(raw)
-    trial = config.trial_config(config.grid_points()[0], config.trial_folder("t"))
-    assert trial.start_from is not None
-    assert trial.start_from.decision == "best"
-    assert trial.start_from.selection_cache == str(tmp_path / "cache")
+def test_a_start_from_key_is_refused_in_a_base_and_in_overrides(tmp_path: Path) -> None:
+    base = yaml.safe_load(
+        (ROOT / "configs" / "train" / "attitude_tracking_self_triggered.yaml").read_text()
+    )
+    base_path = tmp_path / "base.yaml"
+    base_path.write_text(yaml.safe_dump({**base, "start_from": {"steps": 8}}))
+    with pytest.raises(ValueError, match="config key 'start_from' was removed"):
+        sweep_config_from_dict(sweep(tmp_path, base=str(base_path)))
+    overrides = {"start_from.steps": 8}
+    with pytest.raises(ValueError, match=r"unknown training-config key 'start_from\.steps'"):
+        sweep_config_from_dict(sweep(tmp_path, overrides=overrides))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 from pathlib import Path
 from typing import Any
@@ -20,6 +22,7 @@ from agents.train.training import (  # noqa: E402
     main,
     whole_rollout_steps,
 )
+from etsc_envs.decisions import DecisionSet, make_decision_env  # noqa: E402
 
 CONFIG_DIR = Path(__file__).parents[1] / "configs" / "train"
 SHIPPED_CONFIG = CONFIG_DIR / "attitude_tracking_ppo.yaml"
@@ -54,8 +57,6 @@ def tiny_config(out_dir: Path, path: Path = SHIPPED_CONFIG) -> dict[str, Any]:
         evaluation_every=0,
         evaluation_env_kwargs=dict(short),
     )
-    if config.get("start_from"):
-        config["start_from"]["steps"] = 128
     config["init_from"] = None  # a later stage's predecessor is not trained here
     return config
 
@@ -225,10 +226,46 @@ def test_init_from_must_be_a_saved_model(tmp_path: Path) -> None:
         config_from_dict(config)
 
 
-def test_init_from_and_start_from_exclude_each_other(tmp_path: Path) -> None:
-    config = tiny_config(tmp_path / "run") | {"init_from": "model.zip", "start_from": {"steps": 8}}
-    with pytest.raises(ValueError, match="'init_from' and 'start_from' exclude each other"):
+@pytest.mark.parametrize(
+    "config_path", sorted(CONFIG_DIR.glob("*_self_triggered.yaml")), ids=lambda p: p.stem
+)
+def test_every_shipped_self_triggered_config_builds_its_decision_set(
+    tmp_path: Path, config_path: Path
+) -> None:
+    """The config's ``decisions:`` block is a set for its id, trained from scratch: holds and
+    trigger actions, no ``start_from``, the wrapper built with its env kwargs."""
+    raw = shipped_config(config_path)
+    assert "start_from" not in raw
+    config = config_from_dict(raw | {"out_dir": str(tmp_path / "run")})
+    assert config.decisions is not None
+    decisions = DecisionSet.from_json(config.decisions)
+    assert decisions.env_id == raw["env_id"]
+    assert len(decisions.actions) == len(raw["decisions"]["actions"])
+    assert decisions.hold_indices and decisions.trigger_indices
+    assert decisions.shield_multiple == raw["decisions"].get("shield_multiple")
+    env = make_decision_env(config.env_id, config.env_kwargs, decisions)
+    try:
+        assert env.action_space == decisions.action_space
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("block", [{"steps": 8}, None, {"decision": "best"}])
+def test_a_start_from_key_is_refused_in_one_line(tmp_path: Path, block) -> None:
+    config = tiny_config(tmp_path / "run") | {"start_from": block}
+    with pytest.raises(ValueError, match="config key 'start_from' was removed") as caught:
         config_from_dict(config)
+    assert "\n" not in str(caught.value)
+    assert main_error(write_config(config, tmp_path)).count("start_from") == 1
+
+
+def main_error(config_path: Path) -> str:
+    """The error line ``python -m agents.train`` prints for ``config_path`` (it exits 2)."""
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr), pytest.raises(SystemExit) as exited:
+        main(["--config", str(config_path)])
+    assert exited.value.code == 2
+    return stderr.getvalue().strip().splitlines()[-1]
 
 
 def test_resume_without_checkpoints_is_a_clear_error(tmp_path: Path) -> None:
@@ -252,9 +289,6 @@ def test_config_rejects_dqn_for_a_multibinary_action(tmp_path: Path) -> None:
         ("evaluation_env_kwargs", [1], "'evaluation_env_kwargs' must be a mapping"),
         ("observation_clip", 0, "'observation_clip' must be a positive number"),
         ("torch_threads", 0, "'torch_threads' must be"),
-        ("start_from", {"steps": 0}, "'start_from.steps' must be a positive integer"),
-        ("start_from", {"steps": 8, "epochs": 0}, "'start_from.epochs' must be a positive"),
-        ("start_from", [8], "'start_from' must be a mapping"),
     ],
 )
 def test_config_rejects_bad_training_options(tmp_path: Path, key, value, message) -> None:

@@ -21,7 +21,11 @@ import pytest
 import yaml
 
 import etsc_envs
+
+pytest.importorskip("stable_baselines3", reason="the train extra is not installed")
 from agents.train.config import load_config
+
+CLIENTS_EXTRA = "rl-zoo3: the clients extra is not installed (pip install -e '.[clients]')"
 
 ROOT = Path(__file__).resolve().parents[1]
 ZOO_FILE = ROOT / "configs" / "zoo" / "ppo.yml"
@@ -67,6 +71,7 @@ def test_the_zoo_file_is_the_train_configs_in_rl_zoo3_keys():
 
 @pytest.mark.parametrize("env_id", sorted(TRAIN_CONFIGS))
 def test_rl_zoo3_trains_each_id_from_the_conf_file(env_id, tmp_path):
+    pytest.importorskip("rl_zoo3", reason=CLIENTS_EXTRA)
     entry = zoo_entries()[env_id]
     env_kwargs = {**entry["env_kwargs"], "horizon_s": SHORT_HORIZON_S.get(env_id, 1.0)}
     command = [

@@ -23,9 +23,14 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from etsc_envs.decisions import SelfTriggeredWrapper, decision_set_v1
+from etsc_envs.decisions import DecisionSet, Hold, SelfTriggeredWrapper, TriggerAction
+from etsc_envs.triggers.family import FamilyPoint
 
 DEFAULT_IDS = ("etsc/AttitudeTracking-v0", "etsc/InnerFormation-v0")
+HOLD_EXPONENTS = range(11)
+"""The benchmark set's holds: 2^0 .. 2^10 = 1024 instants."""
+FACTORS = (0.5, 1.0, 2.0, 4.0)
+"""The benchmark set's scalings of the paper rule's thresholds."""
 HOLD_ACTION = 6
 """Hold 2^6 = 64 instants."""
 DECISIONS = {"hold": 3000, "paper": 3000, "random": 2000}
@@ -60,11 +65,25 @@ def time_decisions(
     return time.perf_counter() - start, time.process_time() - start_cpu, steps
 
 
+def benchmark_decisions(env_id: str) -> DecisionSet:
+    """The benchmark's decision set for ``env_id``: holds of 2^j instants (j in
+    :data:`HOLD_EXPONENTS`), then the paper's rule with its thresholds scaled by each of
+    :data:`FACTORS`, capped at the longest hold; no shield."""
+    holds = [Hold(2**exponent) for exponent in HOLD_EXPONENTS]
+    groups = TriggerAction().scaled_groups(env_id)
+    rules = [
+        TriggerAction(FamilyPoint({group: factor for group in groups}), cap=holds[-1].instants)
+        for factor in FACTORS
+    ]
+    return DecisionSet(env_id, (*holds, *rules))
+
+
 def make_wrapper(env_id: str, per_instant: bool) -> SelfTriggeredWrapper:
     """The decision wrapper over ``gym.make(env_id)`` (behind a plain wrapper if
-    ``per_instant``)."""
+    ``per_instant``) with :func:`benchmark_decisions`."""
     env = gym.make(env_id)
-    return SelfTriggeredWrapper(gym.Wrapper(env) if per_instant else env, decision_set_v1(env_id))
+    wrapper_env = gym.Wrapper(env) if per_instant else env
+    return SelfTriggeredWrapper(wrapper_env, benchmark_decisions(env_id))
 
 
 def rates(env_id: str, policy: str, repeats: int, per_instant: bool) -> dict[str, list[float]]:

@@ -36,8 +36,8 @@ with failures crossed, and the paper scenario in a second panel.
 
 A method of ``learned:`` triggers (a search's) is also judged against the **hand-menu front**,
 the envelope of every point that no search found: the sweeps, every other model, and every
-point of each ``--menu`` result (earlier fronts: the pinned rule variants of the decision sets,
-the headlines among them), drawn as a curve of its own (:func:`agents.judge.front.menu_verdict`).
+point of each ``--menu`` result (earlier fronts: hand rule variants, the headlines among
+them), drawn as a curve of its own (:func:`agents.judge.front.menu_verdict`).
 The seeds of one search setting are one method there: a ``--sweep`` front over penalties is
 judged per penalty (:func:`search_groups`).
 
@@ -288,7 +288,7 @@ def search_groups(method: str, points: list[dict[str, Any]]) -> dict[str, list[d
 def hand_menu(result: dict[str, Any]) -> list[dict[str, Any]]:
     """The hand-menu front's points: every point of ``result`` that no search found (the
     paper's threshold sweep, the periodic sweep, other rules' sweeps and every judged or run
-    model whose policy is not a ``learned:`` trigger: the decision sets' pinned rules)."""
+    model whose policy is not a ``learned:`` trigger)."""
     return [
         point
         for points in result["curves"].values()

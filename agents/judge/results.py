@@ -9,7 +9,7 @@ For each scenario set (:mod:`etsc_envs.protocol`; default the paper scenario and
 it runs the paper's trigger, every ``--model`` (several models are training seeds of one
 method), and, for each model, periodic transmission at that model's own rate (every ``k``
 sampling instants on every channel, ``k`` matching the model's mean transmissions on the set;
-models at the same ``k``, such as the seeds of a pinned decision, share one run of it).
+models at the same ``k``, such as seeds that learned the same decisions, share one run of it).
 All scenarios of a set run at once in the native vector env (:mod:`baselines.batch`).
 
 Per set and model it reports the paired per-scenario ratios with 95 % bootstrap intervals

@@ -39,7 +39,7 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
 Keys of ``overrides``, ``grid`` and ``search`` are training-config keys, dotted to reach into
 a mapping: ``seed``, ``total_timesteps``, ``env_kwargs.transmission_penalty``,
 ``hyperparameters.learning_rate``. Paths (``base``, ``results_dir``, the training config's
-``init_from``, ``start_from.selection_cache``) are relative to the current folder, as in
+``init_from``) are relative to the current folder, as in
 ``agents.train``.
 
 Every problem raises a one-line ``ValueError`` naming the key and what it allows.
@@ -92,7 +92,7 @@ OPTIONAL_SWEEP_DEFAULTS: dict[str, Any] = {
     "max_concurrent_trials": None,
     "learner": "train",
 }
-NESTED_TRAINING_KEYS = ("env_kwargs", "hyperparameters", "evaluation_env_kwargs", "start_from")
+NESTED_TRAINING_KEYS = ("env_kwargs", "hyperparameters", "evaluation_env_kwargs")
 """Training-config keys whose value is a mapping that a dotted key may reach into."""
 
 TUNE_DIR = "tune"
@@ -260,9 +260,6 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
     if learner == "train":
         base["out_dir"] = "<trial folder>"
         base["init_from"] = _absolute(base.get("init_from"))
-        start_from = base.get("start_from")
-        if isinstance(start_from, dict) and "selection_cache" in start_from:
-            start_from["selection_cache"] = _absolute(start_from["selection_cache"])
     grid = _check_grid(values["grid"], check_key)
     search = _check_search(values["search"])
     overlap = sorted(set(grid) & set(search))

@@ -41,52 +41,24 @@ A config is a YAML mapping with these keys (the optional ones show their default
 * ``init_from: null`` — a model saved by an earlier run (``model.zip`` or a checkpoint) to
   start from: its weights and, when saved beside it, its observation and return statistics
   (a curriculum, e.g. short episodes first, then the paper's horizon or another λ); it must
-  have been trained for the observation and action spaces of ``env_id``, and excludes
-  ``start_from``;
-* ``start_from: null`` — before reinforcement, clone a fixed behaviour into the policy (its
-  actions, and its returns into the value function; :mod:`agents.train.imitation`): a mapping
-  of the keys below (:class:`StartFrom`); null starts from a random policy, or from
-  ``init_from``, which it excludes:
-
-  * ``decision`` — with ``decisions`` (and only there; required), the decision to clone, by
-    its label (``"paper x0.25"``, ``"hold 64"``:
-    :meth:`etsc_envs.decisions.DecisionSet.label`;
-    :func:`agents.train.imitation.imitate_decision`), or ``best`` to choose it per run: the
-    decision with the highest mean return on the first ``evaluation_scenarios`` validation
-    scenarios at the run's env kwargs, its transmission penalty among them
-    (:mod:`agents.train.decision_selection`; recorded in ``out_dir/decision_selection.json``),
-    so that each λ of a front starts from its own baseline. Without ``decisions`` the
-    per-instant paper trigger is cloned;
-  * ``steps`` — how many steps (with ``decisions``, decisions) of it to run on the training
-    envs and clone (an integer >= 1; required);
-  * ``epochs: 10`` — passes over those steps when cloning;
-  * ``pinned_probability: null`` — with ``decision``, a probability p in (0, 1): after
-    cloning, the policy's action head is set to take the cloned decision with probability p at
-    every observation (:func:`agents.train.imitation.pin_decision`), so that training starts
-    from the fixed decision exactly rather than from a fit of it;
-  * ``candidates: null`` — with ``decision: best``, the labels it chooses among (null: every
-    decision of the set);
-  * ``selection_cache: null`` — with ``decision: best``, a folder in which runs that differ
-    in their transmission penalty alone (a front's trials) share the candidates' validation
-    runs (:func:`agents.train.decision_selection.select_decision`);
+  have been trained for the observation and action spaces of ``env_id``; null starts from a
+  random policy;
 * ``decisions: null`` — train self-triggered decisions instead of the per-instant bit: the
   decision set's own JSON form (:mod:`etsc_envs.decisions.actions`: ``shield_multiple`` and
-  ``actions``, a list of ``{kind: hold, instants: N}`` and ``{kind: trigger, point: {...},
-  cap: N, send_first: ...}``; ``env_id`` is the config's; version 1's keywords, which
-  :func:`~etsc_envs.decisions.actions.read_v1` reads from a model's version-1 decision file,
-  are refused here), trained through
-  :class:`etsc_envs.decisions.SelfTriggeredWrapper` (its ``gamma`` is
+  ``actions``, a list of ``{kind: hold, instants: N}`` and ``{kind: trigger, rule: ...,
+  point: {...}, cap: N, send_first: ...}``; ``env_id`` is the config's), trained from a random
+  policy through :class:`etsc_envs.decisions.SelfTriggeredWrapper` (its ``gamma`` is
   ``hyperparameters.gamma``) on a ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
-  :class:`etsc_envs.decisions.FollowerDecisionEnv`; cloning with
-  ``start_from.decision``). PPO, A2C and MaskablePPO then discount by elapsed instants
-  (:mod:`agents.train.elapsed_discount`); the models are saved with their decision set beside
-  them, so that ``sb3:`` deploys them as transmit/hold policies;
+  :class:`etsc_envs.decisions.FollowerDecisionEnv`). PPO, A2C and MaskablePPO then discount
+  by elapsed instants (:mod:`agents.train.elapsed_discount`); the models are saved with their
+  decision set beside them, so that ``sb3:`` deploys them as transmit/hold policies;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
   batches of a few dozen rows run fastest on one thread; more threads contend with the
   vector env's stepping threads (twice the steps per second with one thread, measured on the
   2-core machine).
 
-Every problem raises a ``ValueError`` naming the key and what it allows.
+Every problem raises a ``ValueError`` naming the key and what it allows; a key of
+:data:`REMOVED_KEYS` is refused with the reason it went.
 """
 
 from __future__ import annotations
@@ -107,7 +79,6 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
-from agents.train.decision_selection import BEST_DECISION
 from baselines.policy_specs import require_env_id
 from etsc_envs.core.files import require_writable_folder
 from etsc_envs.decisions import DecisionSet, make_decision_env
@@ -141,101 +112,17 @@ OPTIONAL_DEFAULTS: dict[str, Any] = {
     "tensorboard": True,
     "torch_threads": 1,
     "init_from": None,
-    "start_from": None,
     "decisions": None,
 }
 
 CONFIG_SET_ARGUMENTS = ("policy", "env", "seed")
 """Constructor arguments that come from the config's own keys, not from ``hyperparameters``."""
 
-START_FROM_REQUIRED_KEYS = ("steps",)
-START_FROM_DEFAULTS: dict[str, Any] = {
-    "decision": None,
-    "epochs": 10,
-    "pinned_probability": None,
-    "candidates": None,
-    "selection_cache": None,
+REMOVED_KEYS = {
+    "start_from": "runs start from a random policy or from 'init_from'; the imitation and "
+    "pinned starts are documented in docs/results.md and the git history",
 }
-"""The keys of a config's ``start_from`` block besides ``steps``, with their defaults."""
-
-
-@dataclasses.dataclass(frozen=True)
-class StartFrom:
-    """A config's ``start_from`` block: the fixed behaviour cloned into the policy before
-    reinforcement (see the module docstring for each key). Each key is checked on its own by
-    :func:`start_from_block`, and against the config's decision set by :meth:`require_fits`."""
-
-    decision: str | None
-    steps: int
-    epochs: int
-    pinned_probability: float | None
-    candidates: list[str] | None
-    selection_cache: str | None
-
-    @property
-    def selects(self) -> bool:
-        """Whether the run chooses its decision (``decision: best``,
-        :func:`agents.train.decision_selection.select_decision`)."""
-        return self.decision == BEST_DECISION
-
-    def require_fits(self, decisions: DecisionSet | None) -> None:
-        """``ValueError`` unless ``decision`` and ``candidates`` are decisions of
-        ``decisions``, the config's decision set (``None`` without ``decisions``, where the
-        paper trigger is cloned and there is no ``decision``)."""
-        if decisions is None:
-            if self.decision is not None:
-                raise ValueError(
-                    "config key 'start_from.decision' needs the key 'decisions' (without it the "
-                    "per-instant paper trigger is cloned)"
-                )
-            return
-        if self.decision is None:
-            raise ValueError(
-                "config key 'start_from.decision' is required with 'decisions': a decision "
-                f"label of the set or {BEST_DECISION!r}"
-            )
-        named = {"decision": [] if self.selects else [self.decision]}
-        named["candidates"] = self.candidates or []
-        for key, labels in named.items():
-            for label in labels:
-                try:
-                    decisions.action(label)
-                except ValueError as error:
-                    raise ValueError(f"config key 'start_from.{key}': {error}") from None
-
-
-def start_from_block(value: Any) -> StartFrom | None:
-    """The config's ``start_from`` value checked key by key (``None`` for null): one
-    ``ValueError`` line naming ``start_from.<key>`` and what it allows."""
-    if value is None:
-        return None
-    block = _check_mapping("start_from", value)
-    require_key_set(block, START_FROM_REQUIRED_KEYS, START_FROM_DEFAULTS, "config 'start_from'")
-    values = {**START_FROM_DEFAULTS, **block}
-    decision = values["decision"]
-    if decision is not None and (not isinstance(decision, str) or not decision):
-        raise ValueError(
-            "config key 'start_from.decision' must be a decision label or "
-            f"{BEST_DECISION!r}, got {decision!r}"
-        )
-    for key in ("candidates", "selection_cache"):
-        if values[key] is not None and decision != BEST_DECISION:
-            raise ValueError(
-                f"config key 'start_from.{key}' needs 'start_from.decision: {BEST_DECISION}', "
-                f"got decision={decision!r}"
-            )
-    if values["pinned_probability"] is not None and decision is None:
-        raise ValueError("config key 'start_from.pinned_probability' needs 'start_from.decision'")
-    return StartFrom(
-        decision=decision,
-        steps=_check_positive_int("start_from.steps", values["steps"]),
-        epochs=_check_positive_int("start_from.epochs", values["epochs"]),
-        pinned_probability=_check_probability(
-            "start_from.pinned_probability", values["pinned_probability"]
-        ),
-        candidates=_check_candidates(values["candidates"]),
-        selection_cache=_check_selection_cache(values["selection_cache"]),
-    )
+"""Keys that configs no longer take → why (refused in one line rather than ignored)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -261,7 +148,6 @@ class TrainConfig:
     tensorboard: bool
     torch_threads: int
     init_from: str | None
-    start_from: StartFrom | None
     decisions: dict[str, Any] | None
 
     @property
@@ -285,14 +171,11 @@ def load_config(path: str | Path, overrides: Mapping[str, Any] | None = None) ->
 
 def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     """Validate a config mapping and fill in the optional keys' defaults."""
+    for key, reason in REMOVED_KEYS.items():
+        if key in raw:
+            raise ValueError(f"config key {key!r} was removed: {reason}")
     _check_key_set(raw)
     values = {**OPTIONAL_DEFAULTS, **raw}
-    start_from = start_from_block(values["start_from"])
-    if values["init_from"] is not None and start_from is not None:
-        raise ValueError(
-            "config keys 'init_from' and 'start_from' exclude each other: a run starts "
-            "from an earlier model or from a cloned decision, not both"
-        )
     algorithm = _check_algorithm(values["algorithm"])
     seed = _check_seed(values["seed"])
     n_envs = _check_positive_int("n_envs", values["n_envs"])
@@ -300,7 +183,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         require_training_seeds(seed, n_envs, "config key 'seed'")
     env_id = _check_env_id(values["env_id"])
     env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
-    decisions = _check_decisions(values, algorithm, env_id, env_kwargs, start_from)
+    decisions = _check_decisions(values, algorithm, env_id, env_kwargs)
     _check_algorithm_fits_env(algorithm, env_id, env_kwargs, decisions)
     return TrainConfig(
         env_id=env_id,
@@ -328,7 +211,6 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         tensorboard=_check_tensorboard(values["tensorboard"]),
         torch_threads=_check_positive_int("torch_threads", values["torch_threads"]),
         init_from=_check_init_from(values["init_from"], env_id, env_kwargs, decisions),
-        start_from=start_from,
         decisions=decisions,
     )
 
@@ -369,80 +251,28 @@ def _check_algorithm(name: Any) -> str:
     return name
 
 
-def _check_probability(key: str, probability: Any) -> float | None:
-    """``probability``: null, or a number in (0, 1)."""
-    if probability is None:
-        return None
-    if (
-        isinstance(probability, bool)
-        or not isinstance(probability, int | float)
-        or not 0.0 < probability < 1.0
-    ):
-        raise ValueError(
-            f"config key {key!r} must be a number in (0, 1) or null, got {probability!r}"
-        )
-    return float(probability)
-
-
-def _check_candidates(candidates: Any) -> list[str] | None:
-    """``start_from.candidates``: null, or a non-empty list of labels."""
-    if candidates is None:
-        return None
-    if (
-        not isinstance(candidates, list)
-        or not candidates
-        or not all(isinstance(label, str) for label in candidates)
-    ):
-        raise ValueError(
-            "config key 'start_from.candidates' must be a non-empty list of decision labels "
-            f"or null, got {candidates!r}"
-        )
-    return list(candidates)
-
-
-def _check_selection_cache(folder: Any) -> str | None:
-    """``start_from.selection_cache``: null, or a folder path."""
-    if folder is not None and (not isinstance(folder, str) or not folder):
-        raise ValueError(
-            f"config key 'start_from.selection_cache' must be a folder path or null, got {folder!r}"
-        )
-    return folder
-
-
 def _check_decisions(
-    values: Mapping[str, Any],
-    algorithm: str,
-    env_id: str,
-    env_kwargs: dict[str, Any],
-    start_from: StartFrom | None,
+    values: Mapping[str, Any], algorithm: str, env_id: str, env_kwargs: dict[str, Any]
 ) -> dict[str, Any] | None:
-    """``values["decisions"]`` (null, or a decision set's version-2 JSON form for ``env_id``:
-    :meth:`~etsc_envs.decisions.DecisionSet.from_json`) as that form, which ``start_from`` fits
-    (:meth:`StartFrom.require_fits`)."""
+    """``values["decisions"]`` (null, or a decision set's JSON form for ``env_id``:
+    :meth:`~etsc_envs.decisions.DecisionSet.from_json`) as that form, once a decision env of
+    ``env_id`` built with ``env_kwargs`` has taken it."""
     if values["decisions"] is None:
         if algorithm == "MaskablePPO":
             raise ValueError("config key 'algorithm': MaskablePPO needs the key 'decisions'")
-        if start_from is not None:
-            start_from.require_fits(None)
         return None
     block = _check_mapping("decisions", values["decisions"])
     if "actions" not in block:
         raise ValueError(
             f"config key 'decisions' must be the decision set's own form {{shield_multiple: ..., "
-            f"actions: [{{kind: hold, instants: N}}, {{kind: trigger, point: {{...}}, cap: N, "
-            f"send_first: ...}}, ...]}}, got the keys {sorted(block)} (version 1's keywords: "
-            f"etsc_envs.decisions.read_decision_set converts them)"
+            f"actions: [{{kind: hold, instants: N}}, {{kind: trigger, rule: ..., point: {{...}}, "
+            f"cap: N, send_first: ...}}, ...]}}, got the keys {sorted(block)}"
         )
     try:
         decisions = DecisionSet.from_json(block, env_id)
-        wrapper = make_decision_env(env_id, env_kwargs, decisions)
+        make_decision_env(env_id, env_kwargs, decisions).close()
     except (TypeError, ValueError) as error:
         raise ValueError(f"config key 'decisions': {' '.join(str(error).split())}") from None
-    try:
-        if start_from is not None:
-            start_from.require_fits(wrapper.decisions)
-    finally:
-        wrapper.close()
     return decisions.to_json()
 
 

@@ -11,9 +11,7 @@ Writes to the output directory ``model.zip`` (a plain SB3 save, loadable by
 config after the command-line overrides and defaults), ``train_summary.json`` (wall time,
 timesteps, steps per second and the last episodes' returns and metrics), and as configured
 ``checkpoints/``, ``tensorboard/`` and ``evaluations.json`` (the policy against the paper's
-trigger during training), and with ``start_from.decision: best`` ``decision_selection.json``
-(every candidate decision's validation summary and the one chosen,
-:mod:`agents.train.decision_selection`). ``--resume`` continues from the newest intact checkpoint in
+trigger during training). ``--resume`` continues from the newest intact checkpoint in
 ``checkpoints/`` up to ``total_timesteps``, keeping the evaluation history up to that
 checkpoint; it refuses checkpoints written under another config (``checkpoints/run.yaml``
 records the config that wrote them; only :data:`RESUMABLE_CHANGES` may differ).
@@ -28,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import functools
 import importlib.util
 import json
@@ -59,14 +56,12 @@ from stable_baselines3.common.on_policy_algorithm import OnPolicyAlgorithm
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, VecNormalize
 
 import etsc_envs
-from agents.train.config import StartFrom, TrainConfig, load_config
-from agents.train.decision_selection import select_decision
+from agents.train.config import TrainConfig, load_config
 from agents.train.elapsed_discount import (
     ElapsedRolloutBuffer,
     ElapsedStepsCallback,
     MaskableElapsedRolloutBuffer,
 )
-from agents.train.imitation import imitate_decision, imitate_paper_trigger
 from agents.train.model_files import write_model
 from agents.train.validation_callback import PaperComparisonCallback
 from agents.train.vector_adapter import make_sb3_vec_env, make_shared_policy_vec_env
@@ -83,7 +78,6 @@ MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
 SUMMARY_FILE = "train_summary.json"
 EVALUATIONS_FILE = "evaluations.json"
-SELECTION_FILE = "decision_selection.json"
 BEST_MODEL_FILE = "best_model.zip"
 """The model with the best mean return on the validation scenarios so far (checkpoint
 choice follows the test protocol), its observation statistics beside it."""
@@ -213,7 +207,6 @@ def _earlier_run_files(out_dir: Path) -> list[Path]:
             CONFIG_FILE,
             SUMMARY_FILE,
             EVALUATIONS_FILE,
-            SELECTION_FILE,
             CHECKPOINT_DIR,
             TENSORBOARD_DIR,
         )
@@ -248,35 +241,13 @@ def _train(
     checkpoint: Path | None,
     callbacks: Sequence[BaseCallback],
 ) -> Path:
-    written = config
-    if config.start_from is not None and config.start_from.selects:
-        chosen = _selected_decision(config, config.start_from, out_dir, fresh=checkpoint is None)
-        config = dataclasses.replace(
-            config, start_from=dataclasses.replace(config.start_from, decision=chosen)
-        )
     env = _checked(
         "env_kwargs", make_training_env, config, checkpoint, exceptions=(TypeError, ValueError)
     )
     model = _build_model(config, env, checkpoint, out_dir)
     decisions = decision_set(config, env)
-    imitation: dict[str, Any] | None = None
-    start_from = config.start_from
-    if checkpoint is None:
-        if config.checkpoint_every:
-            _write_config(written, out_dir / CHECKPOINT_DIR / RUN_FILE)
-        if start_from is not None and decisions is not None:
-            imitation = imitate_decision(
-                model,
-                decisions,
-                str(start_from.decision),
-                start_from.steps,
-                start_from.epochs,
-                pinned_probability=start_from.pinned_probability,
-            )
-        elif start_from is not None:
-            imitation = imitate_paper_trigger(
-                model, config.env_id, config.env_kwargs, start_from.steps, start_from.epochs
-            )
+    if checkpoint is None and config.checkpoint_every:
+        _write_config(config, out_dir / CHECKPOINT_DIR / RUN_FILE)
     if decisions is not None and config.env_id in etsc_envs.PETTINGZOO_ENV_IDS:
         env.env_method("follow_model", model)  # parameter sharing: teammates act as the model
     metrics_callback = EpisodeMetricsCallback()
@@ -305,44 +276,11 @@ def _train(
     wall_time_s = time.perf_counter() - start
     write_model(model, out_dir / MODEL_FILE, decisions)
     env.close()
-    _write_config(written, out_dir / CONFIG_FILE)
+    _write_config(config, out_dir / CONFIG_FILE)
     summary = _summary(config, model, metrics_callback, wall_time_s)
     summary["resumed_from"] = None if checkpoint is None else str(checkpoint)
-    summary["imitation"] = imitation
     atomic_write_text(out_dir / SUMMARY_FILE, json.dumps(summary, indent=2) + "\n")
     return out_dir
-
-
-def _selected_decision(
-    config: TrainConfig, start_from: StartFrom, out_dir: Path, fresh: bool
-) -> str:
-    """The decision a ``start_from.decision: best`` run starts from: chosen on the validation
-    scenarios at the run's env kwargs (:func:`~agents.train.decision_selection.select_decision`) and
-    recorded in ``out_dir/decision_selection.json`` on a fresh run, read back from there on a
-    resume."""
-    path = out_dir / SELECTION_FILE
-    if not fresh:
-        try:
-            return str(json.loads(path.read_text(encoding="utf-8"))["chosen"])
-        except (OSError, ValueError, KeyError) as error:
-            raise ValueError(
-                f"--resume: {path} does not say which decision the run started from ({error})"
-            ) from None
-    env = make_decision_env(config.env_id, config.env_kwargs, config.decisions)
-    decisions = env.decisions
-    env.close()
-    selection = select_decision(
-        config.env_id,
-        {**config.env_kwargs, **config.evaluation_env_kwargs},
-        decisions,
-        config.evaluation_scenarios,
-        start_from.candidates,
-        start_from.selection_cache,
-    )
-    out_dir.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(path, json.dumps(selection, indent=2) + "\n")
-    print(f"start_from.decision: best at these env kwargs is {selection['chosen']!r}", flush=True)
-    return str(selection["chosen"])
 
 
 def _checked(
@@ -399,14 +337,12 @@ def _discounts_elapsed_instants(config: TrainConfig) -> bool:
 
 def training_decision_env(config: TrainConfig) -> gym.Env:
     """One env of ``config.env_id`` taking ``config.decisions``, discounting within an interval
-    by the algorithm's ``gamma`` (for a PettingZoo id, one agent's decisions, its teammates
-    taking ``start_from.decision`` until they follow the model)."""
+    by the algorithm's ``gamma`` (for a PettingZoo id, one agent's decisions)."""
     return make_decision_env(
         config.env_id,
         config.env_kwargs,
         config.decisions,
         gamma=config.hyperparameters.get("gamma", 0.99),
-        teammate_decision=None if config.start_from is None else config.start_from.decision,
     )
 
 
@@ -601,7 +537,7 @@ def _periodic_callbacks(
             config.evaluation_scenarios,
             out_dir / BEST_MODEL_FILE,
             decisions,
-            evaluate_at_start=config.start_from is not None or config.init_from is not None,
+            evaluate_at_start=config.init_from is not None,
         )
         if checkpoint is not None:
             evaluation.restore(_previous_evaluations(out_dir, checkpoint))

@@ -76,7 +76,7 @@ class PaperComparisonCallback(BaseCallback):
             evaluated as :class:`~etsc_envs.decisions.SelfTriggeredPolicy` and saved with
             the set beside it), or ``None``.
         evaluate_at_start: also evaluate the policy training starts from (timesteps 0), so
-            that a run started from a cloned or earlier policy can keep it as its best model
+            that a run started from an earlier model (``init_from``) can keep it as its best model
             when reinforcement only makes it worse.
 
     Logged (TensorBoard and SB3's logger): ``eval/mean_cost``, ``eval/transmissions``,

@@ -26,8 +26,6 @@ PAPER = Paper(
     ),
     # The paper's trigger updates a follower every few seconds (hundreds of 0.01-s instants).
     periodic_every=(10, 50, 100, 200, 500, 1000, 2000, 5000, 10000),
-    # eq. (15) needs 0 < c < 1 (c = 0.6 in the paper): c = 0.15 .. 0.9.
-    factors=(0.25, 0.5, 1.0, 1.5),
     headline_metrics=("converge_time_s", "final_containment_err"),
     reproduction="baselines.reproductions.cluster",
 )

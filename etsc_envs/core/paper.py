@@ -2,8 +2,8 @@
 
 Each problem folder holds ``paper.py`` with ``PAPER = Paper(...)``: the paper's ids, its
 triggering rule (:class:`Rule`: trigger class, threshold keywords, the sweep of a Pareto front),
-other event rules on the same signals, its shield, the periodic sweep and decision factors that
-the learners use, its headline metrics and its reproduction. :mod:`etsc_envs.papers` collects the
+other event rules on the same signals, its shield, the periodic sweep that the learners use,
+its headline metrics and its reproduction. :mod:`etsc_envs.papers` collects the
 records and looks them up by id (:func:`etsc_envs.papers.paper_of`).
 
 This module is problem-agnostic: it imports no trigger, so the trigger modules, the problem
@@ -25,9 +25,6 @@ number."""
 
 PERIODIC_EVERY = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000)
 """Sampling instants between periodic transmissions swept on a Pareto front."""
-
-DEFAULT_FACTORS = (0.5, 1.0, 2.0, 4.0)
-"""Scalings of the paper's threshold offered as self-triggered actions."""
 
 RULE_NAMES = ("paper", "error_time")
 """The names of the event rules a paper record may carry (:attr:`Paper.rules`), as
@@ -78,8 +75,6 @@ class Paper:
         shield: the class of its shield (:class:`etsc_envs.triggers.InnerFormationShield`'s
             interface), where the paper gives a condition under which a hold is unsafe.
         periodic_every: sampling instants between periodic transmissions swept on a front.
-        factors: the scalings of the rule's thresholds a self-triggered decision set offers by
-            default.
         headline_metrics: the paper's own metrics shown beside ``mean_cost`` and the
             transmissions when results are judged.
         reproduction: the module (of the checkout, not installed) that reproduces the paper's
@@ -94,7 +89,6 @@ class Paper:
     error_time: Rule | None = None
     shield: type[Any] | None = None
     periodic_every: tuple[int, ...] = PERIODIC_EVERY
-    factors: tuple[float, ...] = DEFAULT_FACTORS
     headline_metrics: tuple[str, ...] = ()
     reproduction: str = ""
 

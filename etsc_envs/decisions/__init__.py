@@ -10,7 +10,7 @@ transmit/hold policy::
     from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy
 
     env = gym.make("etsc_envs:etsc/AttitudeTracking-v0")
-    decisions = DecisionSet.load("models/AttitudeTracking-v0_self_triggered.zip")
+    decisions = DecisionSet.load("runs/attitude_tracking_self_triggered/model.zip")
     policy = SelfTriggeredPolicy.for_env(model, decisions, env)  # model: SB3's predict
 """
 
@@ -20,8 +20,6 @@ from etsc_envs.decisions.actions import (
     Hold,
     TriggerAction,
     decision_set_path,
-    decision_set_v1,
-    read_decision_set,
 )
 from etsc_envs.decisions.policy import FixedDecision, SelfTriggeredPolicy
 from etsc_envs.decisions.schedule import IntervalSchedule, run_decision_interval
@@ -42,8 +40,6 @@ __all__ = [
     "SelfTriggeredWrapper",
     "TriggerAction",
     "decision_set_path",
-    "decision_set_v1",
     "make_decision_env",
-    "read_decision_set",
     "run_decision_interval",
 ]

@@ -21,8 +21,9 @@ from etsc_envs.triggers.base import batched_observations, policy_interface
 
 
 class FixedDecision:
-    """One decision, always (SB3's ``predict``): the demonstrator of a decision to clone, the
-    teammates of a learner before they follow its model, and a constant-decision policy."""
+    """One decision, always (SB3's ``predict``): the teammates of a learner before they follow
+    its model (:class:`~etsc_envs.decisions.FollowerDecisionEnv`), and a constant-decision
+    policy."""
 
     def __init__(self, action: int) -> None:
         self.action = int(action)

@@ -25,7 +25,8 @@ so the followers' decision instants do not coincide. One step is one decision of
 the *learner* (drawn afresh at every reset, so that one policy learns every follower's place);
 the other followers take their decisions from the shared policy at their own decision instants
 (:meth:`FollowerDecisionEnv.follow_model`: the model being trained, deterministic, through its
-current observation statistics; before that, one fixed decision). The step runs the shared loop
+current observation statistics; before that, the rule at its own thresholds:
+:func:`default_teammate_action`). The step runs the shared loop
 instant by instant until the learner's interval ends, and pays the learner its own channel's
 rewards discounted within the interval. Deployed, the model is a
 :class:`~etsc_envs.decisions.policy.SelfTriggeredPolicy` serving every agent of the PettingZoo
@@ -47,7 +48,7 @@ from etsc_envs import registry
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.validation import require_discount
-from etsc_envs.decisions.actions import DecisionSet, TriggerAction, read_decision_set
+from etsc_envs.decisions.actions import DecisionSet, TriggerAction
 from etsc_envs.decisions.policy import FixedDecision, SelfTriggeredPolicy
 from etsc_envs.decisions.schedule import IntervalSchedule, run_decision_interval
 from etsc_envs.sb3_models import NormalizedModel
@@ -179,9 +180,9 @@ class SelfTriggeredWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
 
 
 def default_teammate_action(decisions: DecisionSet) -> int:
-    """The teammates' decision until :meth:`FollowerDecisionEnv.follow_model` when none is
-    named: the first trigger action at the rule's own thresholds (factor 1), else the set's
-    first trigger action, else its first action."""
+    """The teammates' decision until :meth:`FollowerDecisionEnv.follow_model`: the first
+    trigger action at the rule's own thresholds (factor 1), else the set's first trigger
+    action, else its first action."""
     triggers = decisions.trigger_indices
     for index in triggers:
         action = decisions.actions[index]
@@ -200,8 +201,6 @@ class FollowerDecisionEnv(gym.Env):
         decisions: the decision set (made for ``env_id``).
         env_kwargs: the id's keyword arguments.
         gamma: the per-instant discount within an interval (in (0, 1]).
-        teammate_decision: the label of the teammates' decision until :meth:`follow_model`
-            (``None``: :func:`default_teammate_action`).
     """
 
     metadata: dict[str, Any] = {"render_modes": []}  # noqa: RUF012 (Gymnasium's own form)
@@ -212,7 +211,6 @@ class FollowerDecisionEnv(gym.Env):
         decisions: DecisionSet,
         env_kwargs: dict[str, Any] | None = None,
         gamma: float = 0.99,
-        teammate_decision: str | None = None,
     ) -> None:
         if env_id not in registry.PETTINGZOO_ENV_IDS:
             raise ValueError(
@@ -227,13 +225,7 @@ class FollowerDecisionEnv(gym.Env):
         self.agent_index = agent_observation_index(self.loop)
         self.decisions = decisions
         teammates = SelfTriggeredPolicy.for_env(
-            FixedDecision(
-                default_teammate_action(decisions)
-                if teammate_decision is None
-                else decisions.action(teammate_decision)
-            ),
-            decisions,
-            self.parallel_env,
+            FixedDecision(default_teammate_action(decisions)), decisions, self.parallel_env
         )
         self.teammates = teammates
         self.schedule = teammates.schedule
@@ -324,18 +316,13 @@ def make_decision_env(
     env_kwargs: dict[str, Any],
     decisions: DecisionSet | Mapping[str, Any],
     gamma: float = 0.99,
-    teammate_decision: str | None = None,
 ) -> SelfTriggeredWrapper | FollowerDecisionEnv:
     """Self-triggered decisions in ``env_id`` built with ``env_kwargs``: a
     :class:`SelfTriggeredWrapper` over ``gym.make`` for a Gymnasium id, one agent's
-    :class:`FollowerDecisionEnv` for a PettingZoo id (its teammates taking
-    ``teammate_decision`` until they follow a model; ``None``: the rule at factor 1).
-    ``decisions`` is the set or its JSON form
-    (:func:`~etsc_envs.decisions.actions.read_decision_set`)."""
+    :class:`FollowerDecisionEnv` for a PettingZoo id. ``decisions`` is the set or its JSON
+    form (:meth:`~etsc_envs.decisions.actions.DecisionSet.from_json`)."""
     if not isinstance(decisions, DecisionSet):
-        decisions = read_decision_set(decisions, env_id)
+        decisions = DecisionSet.from_json(decisions, env_id)
     if env_id in registry.PETTINGZOO_ENV_IDS:
-        return FollowerDecisionEnv(
-            env_id, decisions, env_kwargs, gamma=gamma, teammate_decision=teammate_decision
-        )
+        return FollowerDecisionEnv(env_id, decisions, env_kwargs, gamma=gamma)
     return SelfTriggeredWrapper(gym.make(env_id, **env_kwargs), decisions, gamma=gamma)
