@@ -176,7 +176,7 @@ def _episodes_measure(runs: list[list[dict[str, Any]]]) -> Measure:
 
 def _summary(values: np.ndarray) -> dict[str, Any]:
     """Mean and interval of ``(runs, scenarios)`` values; runs that recorded the same values
-    (the seeds of a pinned policy) count as one run."""
+    (seeds that took the same decisions) count as one run."""
     if np.all(values == values[0]):
         values = values[:1]
     if values.shape[0] == 1:
