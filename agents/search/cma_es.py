@@ -132,7 +132,7 @@ class SearchConfig:
 
 MAX_SCENARIOS = 1024
 """The most scenarios one batch may run (``scenarios``, ``validation_size``): a batch keeps every
-scenario's env and record in memory at once (docs/search.md)."""
+scenario's env and record in memory at once; docs/clusters.md lists every key's range)."""
 
 MAX_POPULATION = 1024
 MAX_GENERATIONS = 100_000

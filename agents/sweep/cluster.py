@@ -1,7 +1,7 @@
 """Joining a Ray cluster at ``--address`` (``agents.sweep`` and ``agents.search``): the address
 is tried with a bounded wait before Ray is asked (Ray itself retries an unreachable address for
-minutes), and Ray's refusals come back as one line naming ``--address``, the cluster that
-wants a token (Ray's default for ``ray start`` since 2.5x is token authentication) included.
+minutes), and Ray's refusals come back as one line naming ``--address``, a cluster with token
+authentication (docs/clusters.md) included.
 """
 
 from __future__ import annotations
@@ -14,8 +14,7 @@ CONNECT_TIMEOUT_S = 5.0
 
 TOKEN_HELP = (
     "set RAY_AUTH_MODE=token and give the cluster's token as RAY_AUTH_TOKEN or in the file "
-    "RAY_AUTH_TOKEN_PATH names (default ~/.ray/auth_token, where 'ray start' on the head "
-    "writes it)"
+    "RAY_AUTH_TOKEN_PATH names (default ~/.ray/auth_token)"
 )
 """How to join a cluster that uses token authentication (docs/clusters.md)."""
 
