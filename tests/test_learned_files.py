@@ -79,7 +79,7 @@ MODULATION = ("point", "modulation")
         (("point", "heartbeat_instants"), "200", "key 'point.heartbeat_instants'"),
         (("point", "colour"), 1, "key 'point': unknown keys ['colour']"),
         (("point",), [1, 2], "key 'point' must be a mapping"),
-        (("point", "factors", "psi"), 0.0, "key 'point.factors.psi' must be a number in (0"),
+        (("point", "factors", "psi"), 0.0, "key 'point.factors.psi' must be a finite number > 0"),
         (("point", "factors", "pi"), 1.0, "are not factors of AttitudeTrackingTrigger"),
         (("keywords",), {"nu": 1.0}, "key 'keywords': unknown keys ['nu']"),
         (("keywords",), ["psi"], "key 'keywords' must be a mapping"),

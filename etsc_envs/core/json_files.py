@@ -137,9 +137,12 @@ def require_number(
     infinity)."""
     if infinity and value == "inf":
         value = math.inf
-    allows = f"a number in {'(' if low_open else '['}{low:g}, {high:g}]"
-    if (low, high) == (-math.inf, math.inf):
+    if math.isinf(high) and math.isinf(low):
         allows = "a finite number"
+    elif math.isinf(high):
+        allows = f"a finite number {'>' if low_open else '>='} {low:g}"
+    else:
+        allows = f"a number in {'(' if low_open else '['}{low:g}, {high:g}]"
     if infinity:
         allows += ' or "inf"'
     if isinstance(value, bool) or not isinstance(value, int | float):
