@@ -28,7 +28,9 @@ rliable's stratified bootstrap interval, and the range of the per-seed IQMs; wit
 page states that there is no claim (a claim stands on at least :data:`MIN_CLAIM_SEEDS` seeds).
 
 Writes ``results.json`` (every episode record included) into ``DIR`` (default
-``results/<env name>``) and prints the tables as Markdown. With ``--sweep`` (the results folder
+``results/<env name>``) and prints the tables as Markdown. A ``DIR`` whose ``results.json``
+judged other models (or another id) is refused before any work: each model, or set of seeds,
+gets its own ``--out``. With ``--sweep`` (the results folder
 of ``python -m agents.sweep``) the finished trials that differ only in their seed form one
 method: each such group is compared into ``DIR/<group>/results.json``, its trials' models as
 the method's training seeds.

@@ -598,9 +598,10 @@ class LearnedTrigger:
         from etsc_envs.papers import PAPER_IDS, paper_of  # the records import this module
 
         names = ("format", "version", "env_id", "family", "point", "keywords", "search")
-        data = require_mapping(data, "", names, names[:5])
-        if data["format"] != FORMAT:
-            raise ValueError(f"key 'format' must be {FORMAT!r}, got {data['format']!r}")
+        data = require_mapping(data, "", names)
+        if data.get("format") != FORMAT:
+            raise ValueError(f"key 'format' must be {FORMAT!r}, got {data.get('format')!r}")
+        require_mapping(data, "", names, names[:5])
         if data["version"] != FORMAT_VERSION or isinstance(data["version"], bool):
             raise ValueError(
                 f"key 'version' is {data['version']!r}; this suite reads {FORMAT_VERSION}"
