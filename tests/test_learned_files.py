@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import numba
 import numpy as np
 import pytest
 
@@ -122,6 +123,21 @@ def test_a_file_of_another_id_of_the_same_family_is_refused(tmp_path: Path) -> N
 def test_a_valid_modulated_file_decides_within_its_arrays(tmp_path: Path) -> None:
     """Under NUMBA_BOUNDSCHECK=1 (CI) an index past any array raises IndexError here."""
     assert _decide(_write(tmp_path, VALID)) in (0, 1)
+
+
+@pytest.mark.skipif(not numba.config.BOUNDSCHECK, reason="NUMBA_BOUNDSCHECK=1 only (CI runs it)")
+def test_boundscheck_catches_a_network_shorter_than_its_widths() -> None:
+    """The case the reader refuses, forced past it: with bounds checks compiled in, the kernel
+    raises instead of reading past its parameters (so the CI step can fail)."""
+    learned = LearnedTrigger.from_json(VALID)
+    modulation = learned.point.modulation
+    assert modulation is not None
+    object.__setattr__(modulation, "b2", np.zeros((len(modulation.b2), 0)))
+    env = gym.make(ENV_ID, horizon_s=0.2)
+    policy = learned.policy_for(env)
+    observation, _ = env.reset(seed=0)
+    with pytest.raises(IndexError):
+        policy.predict(observation)
 
 
 # ----------------------------------------------------------------------- properties (hypothesis)
