@@ -10,6 +10,7 @@ import secrets
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -80,6 +81,11 @@ def _head(tmp_path: Path, environment: dict[str, str]) -> Iterator[str]:
     finally:
         head.terminate()
         head.wait(timeout=120)
+        # The head leaves its address as this machine's default cluster; a later ray.init()
+        # without an address would try to join it.
+        current = Path(tempfile.gettempdir()) / "ray" / "ray_current_cluster"
+        if current.is_file() and current.read_text().strip().endswith(f":{port}"):
+            current.unlink()
 
 
 def _run(module: str, arguments: list[str], environment: dict[str, str]) -> tuple[int, str]:

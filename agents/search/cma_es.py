@@ -21,9 +21,9 @@ The algorithm, in full:
    validated mean with the best validation return (the start point, validated at generation
    0, competes too). The test set is never touched here.
 
-Candidates of a generation run in parallel: on a local or remote Ray cluster (the default
-where Ray is installed; ``--address`` or ``RAY_ADDRESS`` for a cluster) or in ``--processes N``
-spawned worker processes. Each generation's candidates and returns are appended to
+Candidates of a generation run in parallel: on a Ray instance of their own (the default where
+Ray is installed), on a Ray cluster (``--address`` or ``RAY_ADDRESS``; docs/clusters.md) or in
+``--processes N`` spawned worker processes. Each generation's candidates and returns are appended to
 ``generations.jsonl`` in the output folder: ``--resume`` rebuilds the CMA-ES state by replaying
 them (pycma's sampler has its own seeded generator, so asking again draws the same candidates;
 no pickle is written) and continues, and the result equals an uninterrupted run's.
@@ -357,8 +357,8 @@ class Evaluator:
         else:
             import ray
 
-            if address is None:
-                ray.init(include_dashboard=False, log_to_driver=False)
+            if address is None:  # a Ray of its own, never one already running here
+                ray.init(address="local", include_dashboard=False, log_to_driver=False)
             else:
                 join(address, include_dashboard=False, log_to_driver=False)
             self.ray = ray
