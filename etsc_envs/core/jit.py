@@ -61,7 +61,7 @@ class PackageFunctionCache(FunctionCache):
         stamp = package_source_stamp(self._py_func.__module__.partition(".")[0])
         # Machine code compiled with NUMBA_BOUNDSCHECK=1 checks every index; Numba's own key
         # leaves the flag out, so without it one run would load the other's code.
-        return f"{stamp}+boundscheck" if numba_config.BOUNDSCHECK else stamp
+        return f"{stamp}+boundscheck" if getattr(numba_config, "BOUNDSCHECK", None) else stamp
 
 
 def _with_cache(dispatcher: Any, cache: type[FunctionCache]) -> Any:
