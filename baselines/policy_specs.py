@@ -20,7 +20,7 @@ from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.paper import RULE_NAMES
 from etsc_envs.core.validation import require_int_at_least
 from etsc_envs.decisions.policy import sb3_policy
-from etsc_envs.papers import ids_with_rule, paper_of, rule_of
+from etsc_envs.papers import ids_with_rule, rule_of
 from etsc_envs.triggers import AlwaysPolicy, PeriodicPolicy, SwitchedPeriodicPolicy
 from etsc_envs.triggers.base import (
     ClockTrigger,
@@ -256,15 +256,16 @@ def _policy_for(
             except ValueError as error:
                 raise ValueError(f"--policy-arg {error}") from None
             learned = dataclasses.replace(learned, point=point)
-        expected = paper_of(env_id).trigger.__name__
-        if learned.family != expected:
-            raise ValueError(
-                f"--policy {spec}: a trigger of the family {learned.family!r} (learned on "
-                f"{learned.env_id}); {env_id} takes the family {expected!r}"
+        try:
+            return learned.trigger(
+                observation_space,
+                action_space,
+                observation_names(),
+                loop().sampling_period_s,
+                env_id,
             )
-        return learned.trigger(
-            observation_space, action_space, observation_names(), loop().sampling_period_s
-        )
+        except ValueError as error:
+            raise ValueError(f"--policy {spec}: {error}") from None
     if spec.startswith("sb3:"):
         if policy_args:
             raise ValueError(f"--policy-arg is not used by sb3 policies, got {policy_args}")

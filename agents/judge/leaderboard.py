@@ -37,7 +37,6 @@ intervals over the tasks (:func:`~baselines.statistics.paired_ratio`).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -52,7 +51,8 @@ from matplotlib import ticker
 
 from baselines.plotting import save
 from baselines.statistics import paired_ratio, seeds_summary, summarize
-from etsc_envs.core.files import atomic_write_text
+from etsc_envs.core.files import atomic_write_text, require_writable_file, require_writable_folder
+from etsc_envs.core.json_files import read_json_file, require_mapping
 
 ROOT = Path(__file__).resolve().parents[2]
 RECORDS = ROOT / "docs" / "results"
@@ -161,7 +161,7 @@ class Row:
 
 
 def _load(path: Path) -> dict[str, Any]:
-    return json.loads(path.read_text(encoding="utf-8"))
+    return require_mapping(read_json_file(path), "")
 
 
 def _episodes_measure(runs: list[list[dict[str, Any]]]) -> Measure:
@@ -769,10 +769,32 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not args.records.is_dir():
         parser.error(f"--records must be a folder of judged records, got {args.records}")
+    needed = [
+        Path(folder) / name
+        for board in BOARDS
+        for folder, name in (
+            (board.curves, "pareto.json"),
+            (board.hand, "results.json"),
+            (board.learned, "results.json"),
+        )
+    ]
+    missing = [str(path) for path in needed if not (args.records / path).is_file()]
+    if missing:
+        parser.error(f"--records {args.records} lacks the judged records {missing}")
     figures = args.out.with_suffix("")
-    boards = all_rows(args.records)
-    text = render(args.records, figures, figures.name, boards)
-    atomic_write_text(args.out, text)
+    try:
+        require_writable_file(args.out, "--out")
+        require_writable_folder(figures, "--out (its figures' folder)")
+        boards = all_rows(args.records)
+        text = render(args.records, figures, figures.name, boards)
+        atomic_write_text(args.out, text)
+    except ValueError as error:
+        parser.error(str(error))
+    except OSError as error:
+        parser.error(f"--out {args.out} could not be written: {error.strerror or error}")
+    except KeyboardInterrupt:
+        print(f"interrupted; {args.out} was not replaced", file=sys.stderr)
+        return 130
     print(f"wrote {args.out} and {len(BOARDS)} figures in {figures}/", file=sys.stderr)
     if args.records.resolve() == RECORDS:
         readme = with_readme_table(README.read_text(encoding="utf-8"), readme_table(boards))

@@ -75,6 +75,7 @@ from baselines.evaluate import evaluate, positive_integer
 from baselines.plotting import save
 from baselines.policy_specs import require_policies
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
+from etsc_envs.core.json_files import read_json_file
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import DEFAULT_SET_SIZE
 
@@ -548,12 +549,15 @@ def main(argv: list[str] | None = None) -> int:
             reuse,
             methods,
             args.judged,
-            [json.loads(path.read_text(encoding="utf-8")) for path in args.menu],
+            [read_json_file(path, f"--menu {path}") for path in args.menu],
         )
+        write_json(result, str(out_dir / "pareto.json"))
+        plot(result, out_dir / "pareto.png")
     except (ValueError, TypeError, OSError, gym.error.Error) as error:
         parser.error(str(error))
-    write_json(result, str(out_dir / "pareto.json"))
-    plot(result, out_dir / "pareto.png")
+    except KeyboardInterrupt:
+        print("\ninterrupted; no file was left partly written", file=sys.stderr)
+        return 130
     for name, points in result["curves"].items():
         for point in points:
             cost, sent = point["mean_cost"], point["transmissions"]

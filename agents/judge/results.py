@@ -28,7 +28,9 @@ rliable's stratified bootstrap interval, and the range of the per-seed IQMs; wit
 page states that there is no claim (a claim stands on at least :data:`MIN_CLAIM_SEEDS` seeds).
 
 Writes ``results.json`` (every episode record included) into ``DIR`` (default
-``results/<env name>``) and prints the tables as Markdown. With ``--sweep`` (the results folder
+``results/<env name>``) and prints the tables as Markdown. A ``DIR`` whose ``results.json``
+judged other models (or another id) is refused before any work: each model, or set of seeds,
+gets its own ``--out``. With ``--sweep`` (the results folder
 of ``python -m agents.sweep``) the finished trials that differ only in their seed form one
 method: each such group is compared into ``DIR/<group>/results.json``, its trials' models as
 the method's training seeds.
@@ -51,6 +53,7 @@ from baselines.evaluate import evaluate, positive_integer
 from baselines.policy_specs import episode_setup, require_policies
 from baselines.statistics import paired_ratio, seeds_ratio
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
+from etsc_envs.core.json_files import read_json_file, require_mapping
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import DEFAULT_SET_SIZE, PROTOCOL_VERSION, SCENARIO_SET_NAMES
 
@@ -426,6 +429,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         env_args = parse_assignments(args.env_arg, "--env-arg")
         for folder, models in methods.items():
+            require_own_results(folder, args.env_id, models)
+        for folder, models in methods.items():
             result = compare(
                 args.env_id,
                 models,
@@ -439,7 +444,30 @@ def main(argv: list[str] | None = None) -> int:
             print(f"wrote {folder / 'results.json'}", flush=True)
     except (ValueError, TypeError, gym.error.Error) as error:
         parser.error(str(error))
+    except OSError as error:
+        parser.error(f"--out {out_dir} could not be written: {error.strerror or error}")
+    except KeyboardInterrupt:
+        print(
+            "\ninterrupted; results written so far are kept, none is partly written",
+            file=sys.stderr,
+        )
+        return 130
     return 0
+
+
+def require_own_results(folder: Path, env_id: str, models: list[str]) -> None:
+    """``ValueError`` before any work when ``folder`` holds the ``results.json`` of other
+    models or another id (a finished comparison is never replaced by another model's; the
+    same models are judged again in place)."""
+    path = folder / "results.json"
+    if not path.exists():
+        return
+    record = require_mapping(read_json_file(path, f"--out {path}"), "")
+    if record.get("env") != env_id or record.get("models") != list(models):
+        raise ValueError(
+            f"--out {folder} holds the results of {record.get('models')} on "
+            f"{record.get('env')}; give each model its own --out"
+        )
 
 
 if __name__ == "__main__":

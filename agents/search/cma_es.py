@@ -21,9 +21,9 @@ The algorithm, in full:
    validated mean with the best validation return (the start point, validated at generation
    0, competes too). The test set is never touched here.
 
-Candidates of a generation run in parallel: on a local or remote Ray cluster (the default
-where Ray is installed; ``--address`` or ``RAY_ADDRESS`` for a cluster) or in ``--processes N``
-spawned worker processes. Each generation's candidates and returns are appended to
+Candidates of a generation run in parallel: on a Ray instance of their own (the default where
+Ray is installed), on a Ray cluster (``--address`` or ``RAY_ADDRESS``; docs/clusters.md) or in
+``--processes N`` spawned worker processes. Each generation's candidates and returns are appended to
 ``generations.jsonl`` in the output folder: ``--resume`` rebuilds the CMA-ES state by replaying
 them (pycma's sampler has its own seeded generator, so asking again draws the same candidates;
 no pickle is written) and continues, and the result equals an uninterrupted run's.
@@ -53,10 +53,33 @@ import numpy as np
 import yaml
 
 import etsc_envs
-from etsc_envs.core.files import atomic_write_text, output_folder_argument
+from agents.sweep.cluster import check_reachable, join
+from etsc_envs.core.files import (
+    atomic_write_text,
+    output_folder_argument,
+    require_writable_folder,
+)
+from etsc_envs.core.json_files import (
+    in_file,
+    read_json_lines,
+    require_array,
+    require_integer,
+    require_mapping,
+    require_number,
+    require_string,
+    require_strings,
+)
+from etsc_envs.core.validation import MAX_TRANSMISSION_PENALTY
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import require_training_seeds, scenario_set
-from etsc_envs.triggers.family import FamilyPoint, LearnedTrigger, Modulation
+from etsc_envs.triggers.family import (
+    MAX_HIDDEN,
+    FamilyPoint,
+    LearnedTrigger,
+    Modulation,
+    require_factors,
+    require_keywords,
+)
 
 TRAINING_SEED_BASE = 10_000_000
 """Training scenario seeds start here (above the protocol's reserved ranges): run seed S,
@@ -107,12 +130,23 @@ class SearchConfig:
         return args
 
 
+MAX_SCENARIOS = 1024
+"""The most scenarios one batch may run (``scenarios``, ``validation_size``): a batch keeps every
+scenario's env and record in memory at once; docs/clusters.md lists every key's range)."""
+
+MAX_POPULATION = 1024
+MAX_GENERATIONS = 100_000
+MAX_SIGMA = 2.0 * LOG2_FACTOR_RANGE
+MAX_SEED = 2**31 - 1
+
+
 def read_config(path: str | Path) -> dict[str, Any]:
     """The mapping of keys in the YAML file ``path`` (``ValueError`` naming ``--config``)."""
     try:
         raw = yaml.safe_load(Path(path).read_text())
-    except (OSError, yaml.YAMLError) as error:
-        raise ValueError(f"--config {path}: {error}") from None
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, RecursionError) as error:
+        reason = getattr(error, "strerror", None) or str(error).splitlines()[0]
+        raise ValueError(f"--config {path}: not a readable YAML file ({reason})") from None
     if not isinstance(raw, dict):
         raise ValueError(f"--config {path}: a search config is a mapping of keys")
     return raw
@@ -125,40 +159,81 @@ def load_config(path: str | Path) -> SearchConfig:
 
 
 def config_from_dict(raw: dict[str, Any]) -> SearchConfig:
-    allowed = {f for f in SearchConfig.__dataclass_fields__}
-    unknown = set(raw) - allowed
-    if unknown:
-        raise ValueError(
-            f"search config: unknown keys {sorted(unknown)}; allowed {sorted(allowed)}"
+    """The search config of the mapping ``raw``, every key checked for its kind and range when
+    it is read, before any work (``ValueError``: ``config key 'search.KEY' ...``, one line)."""
+    try:
+        return _checked_config(raw)
+    except ValueError as error:
+        raise ValueError(f"config {error}") from None
+
+
+def _checked_config(raw: dict[str, Any]) -> SearchConfig:
+    """:func:`config_from_dict`'s checks, naming keys as ``key 'search.KEY'``."""
+    fields = SearchConfig.__dataclass_fields__
+    raw = require_mapping(raw, "search", fields, ("env_id", "penalty", "start", "search"))
+    env_id = require_string(raw["env_id"], "search.env_id", PAPER_IDS)
+    family = paper_of(env_id).trigger
+    search = require_strings(raw["search"], "search.search", DIMENSIONS)
+    if not search:
+        raise ValueError(f"key 'search.search' must name at least one of {list(DIMENSIONS)}")
+    start = FamilyPoint.from_json(raw["start"], "search.start")
+    require_factors(family, start.factors, "search.start.factors")
+    counts = {
+        key: require_integer(raw.get(key, default), f"search.{key}", least, most)
+        for key, default, least, most in (
+            ("generations", None, 1, MAX_GENERATIONS),
+            ("population", None, 2, MAX_POPULATION),
+            ("scenarios", None, 1, MAX_SCENARIOS),
+            ("validate_every", 5, 1, MAX_GENERATIONS),
+            ("validation_size", 16, 1, MAX_SCENARIOS),
+            ("hidden", 4, 1, MAX_HIDDEN),
+            ("seed", 0, 0, MAX_SEED),
         )
-    env_id = raw.get("env_id")
-    if env_id not in PAPER_IDS:
-        raise ValueError(f"env_id must be one of {list(PAPER_IDS)}, got {env_id!r}")
-    search = tuple(raw.get("search", ()))
-    if not search or set(search) - set(DIMENSIONS):
-        raise ValueError(f"search must be a non-empty list of {DIMENSIONS}, got {list(search)}")
-    values = dict(raw)
-    values["search"] = search
-    values["start"] = FamilyPoint.from_json(raw.get("start", {}))
-    values["inputs"] = tuple(raw.get("inputs", ()))
-    for key, least in (("generations", 1), ("population", 2), ("scenarios", 1)):
-        _integer(key, values.get(key), least)
-    _integer("validate_every", values.get("validate_every", 5), 1)
-    _integer("validation_size", values.get("validation_size", 16), 1)
-    _integer("hidden", values.get("hidden", 4), 1)
-    _integer("seed", values.get("seed", 0), 0)
-    for key in ("penalty", "sigma"):
-        value = values.get(key, 1.0)
-        if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
-            raise ValueError(f"{key} must be a number > 0, got {value!r}")
-        if not math.isfinite(value):
-            raise ValueError(f"{key} must be finite, got {value!r}")
-    horizon = values.get("horizon_s")
-    if horizon is not None and not (isinstance(horizon, int | float) and horizon > 0):
-        raise ValueError(f"horizon_s must be a number > 0 (s) or absent, got {horizon!r}")
-    if "modulation" in search and not values["inputs"]:
-        raise ValueError("inputs: a search of modulation names the observations it reads")
-    return SearchConfig(**values)
+    }
+    penalty = require_number(
+        raw["penalty"], "search.penalty", low=0.0, high=MAX_TRANSMISSION_PENALTY, low_open=True
+    )
+    sigma = require_number(
+        raw.get("sigma", 1.0), "search.sigma", low=0.0, high=MAX_SIGMA, low_open=True
+    )
+    horizon_s = raw.get("horizon_s")
+    if horizon_s is not None:
+        horizon_s = require_number(horizon_s, "search.horizon_s", low=0.0, low_open=True)
+    names = _observation_names(env_id, horizon_s)
+    inputs = require_strings(raw.get("inputs", []), "search.inputs", names)
+    if ("modulation" in search) != bool(inputs):
+        raise ValueError(
+            "key 'search.inputs' names the observations the network reads: needed by a search "
+            "of modulation, and only by one"
+        )
+    return SearchConfig(
+        env_id=env_id,
+        penalty=penalty,
+        start=start,
+        search=search,
+        sigma=sigma,
+        horizon_s=horizon_s,
+        inputs=inputs,
+        keywords=require_keywords(family, raw.get("keywords", {}), "search.keywords"),
+        **counts,
+    )
+
+
+def _observation_names(env_id: str, horizon_s: float | None) -> tuple[str, ...]:
+    """The observation names of one agent of ``env_id``'s closed loop; ``ValueError`` naming
+    ``search.horizon_s`` where the env refuses that horizon."""
+    loop_id = etsc_envs.PETTINGZOO_LOOP_IDS.get(env_id, env_id)
+    try:
+        env = gym.make(loop_id, **({} if horizon_s is None else {"horizon_s": horizon_s}))
+    except ValueError as error:
+        raise ValueError(f"key 'search.horizon_s': {error}") from None
+    names = tuple(env.unwrapped.observation_names)
+    env.close()
+    if env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        parallel = etsc_envs.make_parallel(env_id)
+        names = tuple(parallel.unwrapped.agent_observation_names)
+        parallel.close()
+    return names
 
 
 def _integer(key: str, value: Any, least: int) -> int:
@@ -282,7 +357,10 @@ class Evaluator:
         else:
             import ray
 
-            ray.init(address=address, include_dashboard=False, log_to_driver=False)
+            if address is None:  # a Ray of its own, never one already running here
+                ray.init(address="local", include_dashboard=False, log_to_driver=False)
+            else:
+                join(address, include_dashboard=False, log_to_driver=False)
             self.ray = ray
             self.remote_score = ray.remote(score)
             self.description = f"Ray at {address or 'a local cluster'}"
@@ -368,16 +446,18 @@ def run_search(
 
     out.mkdir(parents=True, exist_ok=True)
     log_path = out / "generations.jsonl"
-    history = (
-        [json.loads(line) for line in log_path.read_text().splitlines()]
-        if (log_path.is_file())
-        else []
-    )
+    history, torn = read_history(log_path, config, len(space.lower))
     for record in history:  # replay: the same draws, told the recorded returns
         candidates = es.ask()
         if not np.allclose(np.array(candidates), np.array(record["candidates"]), atol=1e-12):
             raise ValueError(f"--resume: {log_path} was written by another config or seed")
         es.tell(candidates, [-value for value in record["returns"]])
+    if torn:
+        atomic_write_text(log_path, "".join(json.dumps(record) + "\n" for record in history))
+        progress(
+            f"--resume: dropped the torn last line of {log_path} (a generation cut off while "
+            "being written); that generation runs again"
+        )
 
     validation = scenario_set("validation", config.validation_size)
     validation_args = {**validation.env_args, **config.env_args(training=False)}
@@ -432,6 +512,46 @@ def run_search(
             f"mean {np.mean(returns):.4g}{validated}; {elapsed:.0f} s, about {eta:.0f} s left"
         )
     return finish(config, out, history)
+
+
+SCORE_KEYS = ("return", "mean_cost", "transmissions", "failures", "steps")
+"""What :func:`score` returns, and a record's ``validation`` holds beside the point."""
+
+
+def read_history(
+    log_path: Path, config: SearchConfig, dimension: int
+) -> tuple[list[dict[str, Any]], bool]:
+    """The generations recorded in ``log_path`` (none if it does not exist), each checked by
+    the suite's JSON reader against the search's shapes (``config.population`` candidates of
+    ``dimension`` numbers), and whether a torn last line was left out; ``ValueError`` naming
+    the line and key of a damaged record."""
+    if not log_path.is_file():
+        return [], False
+    where = f"--resume: {log_path}"
+    records, torn = read_json_lines(log_path, where)
+    population = config.population
+    keys = ("generation", "candidates", "returns", "transmissions", "mean_cost", "env_steps")
+    with in_file(where):
+        for number, record in enumerate(records, start=1):
+            with in_file(f"line {number}"):
+                record = require_mapping(record, "", (*keys, "wall_s", "validation"), keys)
+                require_integer(record["generation"], "generation", number - 1, number - 1)
+                require_array(record["candidates"], "candidates", (population, dimension))
+                for key in ("returns", "transmissions", "mean_cost"):
+                    require_array(record[key], key, (population,))
+                require_integer(record["env_steps"], "env_steps", 0, 2**62)
+                require_number(record.get("wall_s", 0.0), "wall_s", low=0.0)
+                if "validation" in record:
+                    validation = require_mapping(
+                        record["validation"],
+                        "validation",
+                        ("point", *SCORE_KEYS),
+                        ("point", *SCORE_KEYS),
+                    )
+                    FamilyPoint.from_json(validation["point"], "validation.point")
+                    for key in SCORE_KEYS:
+                        require_number(validation[key], f"validation.{key}")
+    return records, torn
 
 
 def finish(config: SearchConfig, out: Path, history: list[dict[str, Any]]) -> LearnedTrigger:
@@ -529,17 +649,17 @@ def main(argv: list[str] | None = None) -> int:
             config = replace(config, seed=_integer("--seed", args.seed, 0))
         if args.processes is not None:
             _integer("--processes", args.processes, 1)
+        out = args.out or Path("runs/search") / f"{Path(args.config).stem}_seed{config.seed}"
+        require_writable_folder(out, "--out")
+        recorded = {**raw, "seed": config.seed}
+        require_same_search(out, recorded, args.resume, args.overwrite)
+        address = args.address or os.environ.get("RAY_ADDRESS") or None
+        if args.processes is None and address is not None:
+            check_reachable(address)
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    out = args.out or Path("runs/search") / f"{Path(args.config).stem}_seed{config.seed}"
     log_path = out / "generations.jsonl"
-    if log_path.exists() and not (args.resume or args.overwrite):
-        print(
-            f"error: --out {out} holds a search; --resume continues it, --overwrite starts afresh",
-            file=sys.stderr,
-        )
-        return 2
     out.mkdir(parents=True, exist_ok=True)
     from filelock import FileLock, Timeout
 
@@ -553,14 +673,14 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.overwrite and log_path.exists():
             log_path.unlink()
-        atomic_write_text(out / "config.yaml", yaml.safe_dump({**raw, "seed": config.seed}))
+        atomic_write_text(out / "config.yaml", yaml.safe_dump(recorded))
         processes = args.processes
-        if processes is None and args.address is None and not os.environ.get("RAY_ADDRESS"):
+        if processes is None and address is None:
             try:
                 import ray  # noqa: F401
             except ImportError:
                 processes = os.cpu_count() or 1
-        evaluator = Evaluator(processes, args.address)
+        evaluator = Evaluator(processes, address)
         print(
             f"CMA-ES on {config.env_id} (λ = {config.penalty:g}, seed {config.seed}): "
             f"{config.generations} generations of {config.population} on {evaluator.description}"
@@ -568,6 +688,9 @@ def main(argv: list[str] | None = None) -> int:
             flush=True,
         )
         learned = run_search(config, out, evaluator, progress=lambda line: print(line, flush=True))
+    except (ValueError, OSError) as error:
+        print(f"error: {one_line(error)}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(
             f"interrupted; the finished generations are in {log_path}: run the same command with "
@@ -582,3 +705,39 @@ def main(argv: list[str] | None = None) -> int:
     chosen = learned.search["chosen_generation"]
     print(f"learned trigger: {out / 'learned.json'} (the mean of generation {chosen})")
     return 0
+
+
+def require_same_search(out: Path, recorded: dict[str, Any], resume: bool, again: bool) -> None:
+    """``ValueError`` before anything is written when ``out`` holds a search and the command
+    neither continues it (``resume``) nor starts afresh (``again``), or continues it with
+    another config or seed than its ``config.yaml`` records."""
+    if not (out / "generations.jsonl").exists():
+        return
+    if not (resume or again):
+        raise ValueError(
+            f"--out {out} holds a search; --resume continues it, --overwrite starts afresh"
+        )
+    stored = out / "config.yaml"
+    if not resume or not stored.is_file():
+        return
+    try:
+        before = yaml.safe_load(stored.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as error:
+        raise ValueError(f"--resume: {stored} is not readable ({one_line(error)})") from None
+    if not isinstance(before, dict):
+        raise ValueError(f"--resume: {stored} is not a search config")
+    changed = sorted(
+        str(key) for key in set(before) | set(recorded) if before.get(key) != recorded.get(key)
+    )
+    if changed:
+        raise ValueError(
+            f"--resume: --out {out} holds a search of another config or seed (keys {changed} "
+            "differ from its config.yaml); continue it with the same config and --seed, or "
+            "start afresh with --overwrite or another --out"
+        )
+
+
+def one_line(error: BaseException) -> str:
+    """The first line of ``error``'s message (its kind where it has none)."""
+    text = str(error).strip()
+    return text.splitlines()[0] if text else type(error).__name__

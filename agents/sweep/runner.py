@@ -33,14 +33,13 @@ import argparse
 import functools
 import json
 import os
-import socket
 import sys
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlsplit
 
 import yaml
 
+from agents.sweep.cluster import check_reachable, join
 from agents.sweep.config import SweepConfig, load_sweep_config
 from agents.sweep.processes import run_sweep_in_processes
 from agents.sweep.results import (
@@ -52,47 +51,17 @@ from agents.sweep.results import (
 )
 from etsc_envs.core.files import require_writable_folder
 
-CONNECT_TIMEOUT_S = 5.0
-"""How long the command waits for a Ray address to accept a connection."""
-
-
-def check_reachable(address: str) -> None:
-    """``ValueError`` unless ``address`` (``host:port`` or ``ray://host:port``) accepts a TCP
-    connection within :data:`CONNECT_TIMEOUT_S` (Ray itself would retry for minutes).
-    ``auto`` and ``local`` are Ray's own words and pass through."""
-    if address in ("auto", "local"):
-        return
-    parts = urlsplit(address if "://" in address else f"//{address}")
-    try:
-        host, port = parts.hostname, parts.port
-    except ValueError:
-        host, port = None, None
-    if not host or port is None:
-        raise ValueError(f"--address must be HOST:PORT or ray://HOST:PORT, got {address!r}")
-    try:
-        with socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S):
-            pass
-    except OSError as error:
-        raise ValueError(
-            f"--address: no Ray cluster answers at {address!r} ({error.strerror or error}); "
-            f"start one with 'ray start --head' or leave --address out to run on this machine"
-        ) from None
-
 
 def connect(address: str | None) -> None:
-    """Join the Ray cluster at ``address``, or start a Ray instance on this machine (never
-    another one already running here, which Ray's default would join)."""
+    """Join the Ray cluster at ``address`` (:func:`agents.sweep.cluster.join`), or start a Ray
+    instance on this machine (never another one already running here, which Ray's default
+    would join)."""
     import ray
 
     if address is None:
         ray.init(address="local", include_dashboard=False)
         return
-    try:
-        ray.init(address=address)
-    except ConnectionError as error:
-        raise ValueError(
-            f"--address: cannot join the Ray cluster at {address!r}: {error}"
-        ) from None
+    join(address)
 
 
 def build_tuner(sweep: SweepConfig, resume: bool) -> Any:
@@ -206,7 +175,7 @@ def run_sweep(sweep: SweepConfig, address: str | None, resume: bool) -> list[Swe
     if resume and not tune.Tuner.can_restore(str(sweep.tune_dir)):
         raise ValueError(f"--resume: no saved sweep in {str(sweep.tune_dir)!r} to continue")
     if address is not None:
-        check_reachable(address)
+        check_reachable(address)  # before anything is written
     sweep.start_or_continue(resume, sweep.tune_dir.exists() or sweep.trials_dir.exists())
     connect(address)
     try:

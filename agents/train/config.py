@@ -68,6 +68,7 @@ import importlib
 import importlib.util
 import inspect
 import math
+import os
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -190,7 +191,9 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         env_kwargs=env_kwargs,
         algorithm=algorithm,
         policy=_check_policy(values["policy"], algorithm),
-        hyperparameters=_check_hyperparameters(values["hyperparameters"], algorithm),
+        hyperparameters=_check_buffer_fits(
+            _check_hyperparameters(values["hyperparameters"], algorithm), n_envs
+        ),
         total_timesteps=_check_positive_int("total_timesteps", values["total_timesteps"]),
         n_envs=n_envs,
         seed=seed,
@@ -344,6 +347,35 @@ def _check_hyperparameters(value: Any, algorithm: str) -> dict[str, Any]:
     for name, entry in hyperparameters.items():
         _reject_numeric_string(f"hyperparameters.{name}", entry)
         _check_hyperparameter(name, entry, defaults.get(name))
+    return hyperparameters
+
+
+MIN_SAMPLE_BYTES = 64
+"""The least memory one stored sample takes in SB3's rollout or replay buffer: the observation
+(no id's has fewer than 10 float32 numbers), the action, and the reward, value, return, log
+probability, advantage and episode start of the step."""
+
+
+def machine_memory_bytes() -> int:
+    """The physical memory of this machine."""
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def _check_buffer_fits(hyperparameters: dict[str, Any], n_envs: int) -> dict[str, Any]:
+    """``hyperparameters`` unless the buffer they ask for (``n_steps`` per env times
+    ``n_envs``, or ``buffer_size``) needs more than half of this machine's memory at
+    :data:`MIN_SAMPLE_BYTES` a sample (``ValueError`` naming the key, before any allocation)."""
+    available = machine_memory_bytes() // 2
+    for name, samples in (
+        ("n_steps", hyperparameters.get("n_steps", 0) * n_envs),
+        ("buffer_size", hyperparameters.get("buffer_size", 0)),
+    ):
+        if samples * MIN_SAMPLE_BYTES > available:
+            raise ValueError(
+                f"config key 'hyperparameters.{name}' asks for a buffer of {samples:.3g} samples, "
+                f"at least {samples * MIN_SAMPLE_BYTES / 2**30:.3g} GiB; this machine has "
+                f"{available / 2**30:.3g} GiB for it (half its memory)"
+            )
     return hyperparameters
 
 

@@ -29,6 +29,17 @@ from contextlib import contextmanager
 from pathlib import Path
 
 
+def _resolved(path: Path, argument: str) -> Path:
+    """``path`` with its links resolved, or ``ValueError`` naming ``argument`` for a link that
+    leads back to itself."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError) as error:
+        raise ValueError(
+            f"{argument} cannot be written: {str(path)!r} is a symbolic link loop ({error})"
+        ) from None
+
+
 def _nearest_existing(path: Path, argument: str) -> Path:
     """The nearest existing folder among ``path``'s parents (``path`` itself excluded), or
     ``ValueError`` naming ``argument`` when that nearest existing one is a file."""
@@ -62,7 +73,7 @@ def require_writable_file(path: str | Path, argument: str) -> Path:
     a file, or no file can be created in the folder that would hold it. An existing device or
     FIFO passes (it is written in place)."""
     path = Path(path)
-    target = path.resolve()
+    target = _resolved(path, argument)
     if target.is_dir():
         raise ValueError(f"{argument} must name a file, got the folder {str(path)!r}")
     if target.exists() and not target.is_file():
@@ -77,7 +88,7 @@ def require_writable_folder(path: str | Path, argument: str) -> Path:
     """``path`` as a :class:`Path` if it is, or can become, a folder in which files can be
     created, else ``ValueError`` naming ``argument``."""
     path = Path(path)
-    target = path.resolve()
+    target = _resolved(path, argument)
     if target.exists() and not target.is_dir():
         raise ValueError(f"{argument} must name a folder, got the file {str(path)!r}")
     _probe(target if target.is_dir() else _nearest_existing(target, argument), argument)

@@ -8,7 +8,8 @@ The machine code is cached on disk. Numba invalidates a cached function only whe
 source file changes, yet a compiled function carries the code of the compiled functions it
 calls: after an edit of, say, ``core/rotations.py`` every caller in another file would load
 its old machine code and silently compute with the old rotations. The caches here therefore
-key every entry also by :func:`package_source_stamp`, which any edit of the package changes.
+key every entry also by :func:`package_source_stamp`, which any edit of the package changes,
+and by ``NUMBA_BOUNDSCHECK`` (code compiled with bounds checks is cached apart).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from numba import config as numba_config
 from numba import njit
 from numba.core.caching import FunctionCache
 
@@ -56,7 +58,10 @@ class PackageFunctionCache(FunctionCache):
         return signature, magic, (*hashes, self._package_stamp())
 
     def _package_stamp(self) -> str:
-        return package_source_stamp(self._py_func.__module__.partition(".")[0])
+        stamp = package_source_stamp(self._py_func.__module__.partition(".")[0])
+        # Machine code compiled with NUMBA_BOUNDSCHECK=1 checks every index; Numba's own key
+        # leaves the flag out, so without it one run would load the other's code.
+        return f"{stamp}+boundscheck" if getattr(numba_config, "BOUNDSCHECK", None) else stamp
 
 
 def _with_cache(dispatcher: Any, cache: type[FunctionCache]) -> Any:

@@ -134,6 +134,12 @@ def require_spd_matrix(name: str, value: Iterable[Iterable[float]]) -> np.ndarra
     eigenvalues = np.linalg.eigvalsh(matrix)
     if eigenvalues.min() <= 0.0:
         raise ValueError(f"{name} must be positive definite, got eigenvalues {eigenvalues}")
+    log_determinant = float(np.sum(np.log(eigenvalues)))
+    if not np.log(np.finfo(float).tiny) <= log_determinant <= np.log(np.finfo(float).max):
+        raise ValueError(
+            f"{name} must have a determinant inside float64's normal range (solving with it "
+            f"divides by it), got eigenvalues {eigenvalues}"
+        )
     if eigenvalues.max() > MAX_CONDITION_NUMBER * eigenvalues.min():
         raise ValueError(
             f"{name} must be well conditioned (largest / smallest eigenvalue <= "

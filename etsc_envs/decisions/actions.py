@@ -49,6 +49,7 @@ import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.files import atomic_write_text
+from etsc_envs.core.json_files import read_json_file
 from etsc_envs.core.paper import RULE_NAMES
 from etsc_envs.papers import PAPERS, paper_of, rule_of
 from etsc_envs.triggers.base import RuleTrigger
@@ -224,11 +225,8 @@ class TriggerAction:
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> TriggerAction:
         _require_keys("trigger", data, {"kind", "rule", "point", "cap", "send_first"}, set())
-        point = data.get("point", {})
-        if not isinstance(point, Mapping):
-            raise ValueError(f"point must be a mapping of FamilyPoint keys, got {point!r}")
         return cls(
-            point=FamilyPoint.from_json(point),
+            point=FamilyPoint.from_json(data.get("point", {})),
             rule=data.get("rule", "paper"),
             cap=data.get("cap", MAX_INSTANTS),
             send_first=data.get("send_first", False),
@@ -410,6 +408,6 @@ class DecisionSet:
         unreadable."""
         path = decision_set_path(model_path)
         try:
-            return cls.from_json(json.loads(path.read_text()))
-        except (OSError, ValueError, TypeError, KeyError) as error:
+            return cls.from_json(read_json_file(path))
+        except (ValueError, TypeError, KeyError) as error:
             raise ValueError(f"decision set {path} is not readable ({error})") from None

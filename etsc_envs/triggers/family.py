@@ -35,6 +35,7 @@ instants after a transmission (:func:`~etsc_envs.triggers.base.instants_seconds`
 from __future__ import annotations
 
 import functools
+import inspect
 import json
 import math
 from collections.abc import Callable, Mapping
@@ -46,6 +47,17 @@ import gymnasium as gym
 import numpy as np
 
 from etsc_envs.core.jit import closure_jit, jit
+from etsc_envs.core.json_files import (
+    in_file,
+    read_json_file,
+    require_array,
+    require_bool,
+    require_env_id,
+    require_mapping,
+    require_number,
+    require_string,
+    require_strings,
+)
 from etsc_envs.triggers.base import (
     RuleTrigger,
     instants_seconds,
@@ -57,6 +69,9 @@ from etsc_envs.triggers.base import (
 FORMAT = "etsc-envs/learned-trigger"
 """The ``format`` key of a learned trigger's JSON file."""
 FORMAT_VERSION = 1
+
+MAX_HIDDEN = 16
+"""The widest hidden layer of the modulation network."""
 
 MODULATION_BOUND = 3.0
 """|g| is clipped here: the network scales a threshold or bound by at most e^3 ≈ 20 either way."""
@@ -95,27 +110,36 @@ class Modulation:
     b3: np.ndarray
 
     def __post_init__(self) -> None:
-        n_in = len(self.inputs)
-        h1, h2 = len(self.b1), len(self.b2)
-        shapes = {
-            "mean": (n_in,),
-            "scale": (n_in,),
-            "w1": (h1, n_in),
-            "w2": (h2, h1),
-            "w3": (3, h2),
-            "b3": (3,),
-        }
+        for name in ("b1", "b2"):
+            bias = np.asarray(getattr(self, name), dtype=np.float64)
+            if bias.ndim != 1 or not 1 <= bias.size <= MAX_HIDDEN:
+                raise ValueError(
+                    f"modulation.{name} must be one row of 1..{MAX_HIDDEN} numbers, got shape "
+                    f"{bias.shape}"
+                )
+        shapes = self.shapes(len(self.inputs), len(self.b1), len(self.b2))
         for name, shape in shapes.items():
             value = np.asarray(getattr(self, name), dtype=np.float64)
             if value.shape != shape or not np.all(np.isfinite(value)):
                 raise ValueError(f"modulation.{name} must be finite of shape {shape}")
             object.__setattr__(self, name, value)
-        for name in ("b1", "b2"):
-            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=np.float64))
         if np.any(self.scale <= 0.0):
             raise ValueError("modulation.scale must be > 0")
-        if not 1 <= h1 <= 16 or not 1 <= h2 <= 16:
-            raise ValueError(f"modulation layers must have 1..16 units, got {h1}, {h2}")
+
+    @staticmethod
+    def shapes(n_inputs: int, h1: int, h2: int) -> dict[str, tuple[int, ...]]:
+        """The shape of every array of a network on ``n_inputs`` inputs with hidden layers of
+        ``h1`` and ``h2`` units (the compiled kernel reads them by these sizes)."""
+        return {
+            "mean": (n_inputs,),
+            "scale": (n_inputs,),
+            "w1": (h1, n_inputs),
+            "b1": (h1,),
+            "w2": (h2, h1),
+            "b2": (h2,),
+            "w3": (3, h2),
+            "b3": (3,),
+        }
 
     @classmethod
     def zeros(
@@ -168,15 +192,25 @@ class Modulation:
         }
 
     @classmethod
-    def from_json(cls, data: Mapping[str, Any]) -> Modulation:
+    def from_json(cls, data: Any, key: str = "modulation") -> Modulation:
+        """The network of the JSON form ``data`` (:meth:`to_json`), every array checked for its
+        shape and finiteness (``ValueError`` naming the key, under ``key``)."""
         names = ("inputs", "mean", "scale", "w1", "b1", "w2", "b2", "w3", "b3")
-        missing = [name for name in names if name not in data]
-        if missing:
-            raise ValueError(f"modulation is missing {missing}")
-        return cls(
-            tuple(str(name) for name in data["inputs"]),
-            *(np.asarray(data[name], dtype=np.float64) for name in names[1:]),
-        )
+        data = require_mapping(data, key, names, names)
+        inputs = require_strings(data["inputs"], f"{key}.inputs")
+        if not inputs:
+            raise ValueError(f"key {key + '.inputs'!r} must name at least one observation")
+        widths = [len(require_array(data[name], f"{key}.{name}", (None,))) for name in ("b1", "b2")]
+        for name, width in zip(("b1", "b2"), widths, strict=True):
+            if not 1 <= width <= MAX_HIDDEN:
+                raise ValueError(f"key {f'{key}.{name}'!r} must hold 1..{MAX_HIDDEN} numbers")
+        arrays = {
+            name: require_array(data[name], f"{key}.{name}", shape)
+            for name, shape in cls.shapes(len(inputs), *widths).items()
+        }
+        if np.any(arrays["scale"] <= 0.0):
+            raise ValueError(f"key {key + '.scale'!r} must hold numbers > 0")
+        return cls(inputs, **arrays)
 
 
 def _non_negative_instants(name: str, value: Any) -> float:
@@ -226,7 +260,7 @@ class FamilyPoint:
         if not math.isfinite(exponent) or abs(exponent) > 4.0:
             raise ValueError(f"exponent must be a number in [-4, 4], got {self.exponent!r}")
         object.__setattr__(self, "exponent", exponent)
-        object.__setattr__(self, "first_instant", bool(self.first_instant))
+        object.__setattr__(self, "first_instant", require_bool(self.first_instant, "first_instant"))
 
     @classmethod
     def clock(cls, every: int) -> FamilyPoint:
@@ -244,19 +278,36 @@ class FamilyPoint:
         }
 
     @classmethod
-    def from_json(cls, data: Mapping[str, Any]) -> FamilyPoint:
-        known = {"factors", "floor_instants", "heartbeat_instants", "exponent", "first_instant"}
-        unknown = set(data) - known - {"modulation"}
-        if unknown:
-            raise ValueError(f"point: unknown keys {sorted(unknown)}; allowed {sorted(known)}")
+    def from_json(cls, data: Any, key: str = "point") -> FamilyPoint:
+        """The point of the JSON form ``data`` (:meth:`to_json`; left-out keys take their
+        defaults), each key checked for its kind and range (``ValueError`` naming the key,
+        under ``key``)."""
+        data = require_mapping(data, key, POINT_KEYS)
+        factors = require_mapping(data.get("factors", {}), f"{key}.factors")
         modulation = data.get("modulation")
         return cls(
-            factors=dict(data.get("factors", {})),
-            floor_instants=_read_number(data.get("floor_instants", 0.0)),
-            heartbeat_instants=_read_number(data.get("heartbeat_instants", "inf")),
-            exponent=float(data.get("exponent", 0.0)),
-            first_instant=bool(data.get("first_instant", False)),
-            modulation=None if modulation is None else Modulation.from_json(modulation),
+            factors={
+                name: require_number(value, f"{key}.factors.{name}", low=0.0, low_open=True)
+                for name, value in factors.items()
+            },
+            floor_instants=require_number(
+                data.get("floor_instants", 0.0), f"{key}.floor_instants", low=0.0, infinity=True
+            ),
+            heartbeat_instants=require_number(
+                data.get("heartbeat_instants", "inf"),
+                f"{key}.heartbeat_instants",
+                low=1.0,
+                infinity=True,
+            ),
+            exponent=require_number(
+                data.get("exponent", 0.0), f"{key}.exponent", low=-4.0, high=4.0
+            ),
+            first_instant=require_bool(data.get("first_instant", False), f"{key}.first_instant"),
+            modulation=(
+                None
+                if modulation is None
+                else Modulation.from_json(modulation, f"{key}.modulation")
+            ),
         )
 
 
@@ -265,8 +316,15 @@ def _json_number(value: float) -> float | str:
     return "inf" if math.isinf(value) else value
 
 
-def _read_number(value: Any) -> float:
-    return math.inf if value == "inf" else float(value)
+POINT_KEYS = (
+    "factors",
+    "floor_instants",
+    "heartbeat_instants",
+    "exponent",
+    "first_instant",
+    "modulation",
+)
+"""The keys of a point's JSON form."""
 
 
 @jit
@@ -358,22 +416,43 @@ def family_rule(
     return rule
 
 
-def scaled_thresholds(
-    trigger_class: type[RuleTrigger], factors: Mapping[str, float]
-) -> dict[str, float]:
-    """The paper's threshold keywords of ``trigger_class`` each multiplied by its group's factor
-    (``ValueError`` naming an unknown factor or one outside the paper's bound)."""
+def require_factors(
+    trigger_class: type[RuleTrigger], factors: Mapping[str, float], key: str = "factors"
+) -> None:
+    """``ValueError`` naming ``key`` for a factor that is none of ``trigger_class``'s groups or
+    lies outside the paper's bound."""
     groups = trigger_class.threshold_groups
     unknown = set(factors) - set(groups)
     if unknown:
         raise ValueError(
-            f"factors: {sorted(unknown)} are not factors of {trigger_class.__name__}; "
+            f"key {key!r}: {sorted(unknown)} are not factors of {trigger_class.__name__}; "
             f"allowed {sorted(groups)}"
         )
     for name, value in factors.items():
         low, high = trigger_class.factor_bounds.get(name, (0.0, math.inf))
         if not low < value < high:
-            raise ValueError(f"factors.{name} must lie in ({low:g}, {high:g}), got {value!r}")
+            raise ValueError(f"key '{key}.{name}' must lie in ({low:g}, {high:g}), got {value!r}")
+
+
+def require_keywords(
+    trigger_class: type[RuleTrigger], keywords: Any, key: str = "keywords"
+) -> dict[str, float]:
+    """``keywords`` when it maps keywords of ``trigger_class`` that its factors leave alone
+    (paper 001's ν) to finite numbers (``ValueError`` naming ``key``)."""
+    parameters = list(inspect.signature(trigger_class.__init__).parameters)[4:]
+    thresholds = {name for names in trigger_class.threshold_groups.values() for name in names}
+    allowed = [name for name in parameters if name not in thresholds]
+    keywords = require_mapping(keywords, key, allowed)
+    return {name: require_number(value, f"{key}.{name}") for name, value in keywords.items()}
+
+
+def scaled_thresholds(
+    trigger_class: type[RuleTrigger], factors: Mapping[str, float]
+) -> dict[str, float]:
+    """The paper's threshold keywords of ``trigger_class`` each multiplied by its group's factor
+    (``ValueError`` naming an unknown factor or one outside the paper's bound)."""
+    require_factors(trigger_class, factors)
+    groups = trigger_class.threshold_groups
     paper = trigger_class.paper_thresholds()
     return {
         keyword: paper[keyword] * float(factors.get(name, 1.0))
@@ -487,6 +566,25 @@ def family_trigger(
     )
 
 
+HAND_KEYS = ("rule", "menu", "chosen_on", "chosen_by", "validation_front", "replaces")
+"""The ``hand`` section of a hand point's file: the rule in words, the menu's labels, the set
+that chose it, how, the record of that choice and what the point replaces."""
+
+
+def read_hand(value: Any) -> dict[str, Any]:
+    """A file's ``hand`` section, checked (``{}`` where the file is a searched trigger's)."""
+    hand = require_mapping(value, "hand", HAND_KEYS)
+    if not hand:
+        return hand
+    require_mapping(hand, "hand", HAND_KEYS, HAND_KEYS[:3])
+    for name in HAND_KEYS:
+        if name == "menu":
+            require_strings(hand[name], "hand.menu")
+        elif name in hand:
+            require_string(hand[name], f"hand.{name}")
+    return hand
+
+
 @dataclass(frozen=True)
 class LearnedTrigger:
     """A point of a trigger family as a file: the environment id, the paper trigger class
@@ -515,21 +613,34 @@ class LearnedTrigger:
         }
 
     @classmethod
-    def from_json(cls, data: Mapping[str, Any]) -> LearnedTrigger:
-        if not isinstance(data, Mapping) or data.get("format") != FORMAT:
-            raise ValueError(f"a learned trigger file has format {FORMAT!r}")
-        if data.get("version") != FORMAT_VERSION:
+    def from_json(cls, data: Any) -> LearnedTrigger:
+        """The learned trigger of the JSON form ``data`` (:meth:`to_json`), every key checked
+        (``ValueError`` naming it): the format and version, an id of the suite and its paper's
+        family, the point and the family's other keywords; ``search`` is the search's record,
+        kept as data, and ``hand`` a hand point's provenance (:func:`read_hand`)."""
+        from etsc_envs.papers import PAPER_IDS, paper_of  # the records import this module
+
+        names = ("format", "version", "env_id", "family", "point", "keywords", "search", "hand")
+        data = require_mapping(data, "", names)
+        if data.get("format") != FORMAT:
+            raise ValueError(f"key 'format' must be {FORMAT!r}, got {data.get('format')!r}")
+        require_mapping(data, "", names, names[:5])
+        if data["version"] != FORMAT_VERSION or isinstance(data["version"], bool):
             raise ValueError(
-                f"learned trigger version {data.get('version')!r}; this suite reads "
-                f"{FORMAT_VERSION}"
+                f"key 'version' is {data['version']!r}; this suite reads {FORMAT_VERSION}"
             )
+        env_id = require_string(data["env_id"], "env_id", PAPER_IDS)
+        trigger_class = paper_of(env_id).trigger
+        family = require_string(data["family"], "family", [trigger_class.__name__])
+        point = FamilyPoint.from_json(data["point"])
+        require_factors(trigger_class, point.factors, "point.factors")
         return cls(
-            env_id=str(data["env_id"]),
-            family=str(data["family"]),
-            point=FamilyPoint.from_json(data["point"]),
-            keywords=dict(data.get("keywords", {})),
-            search=dict(data.get("search", {})),
-            hand=dict(data.get("hand", {})),
+            env_id=env_id,
+            family=family,
+            point=point,
+            keywords=require_keywords(trigger_class, data.get("keywords", {})),
+            search=require_mapping(data.get("search", {}), "search"),
+            hand=read_hand(data.get("hand", {})),
         )
 
     def save(self, path: str | Path) -> None:
@@ -539,22 +650,19 @@ class LearnedTrigger:
 
     @classmethod
     def load(cls, path: str | Path) -> LearnedTrigger:
-        """The learned trigger in the JSON file ``path`` (``ValueError`` naming the path for a
-        file that is not one)."""
-        try:
-            data = json.loads(Path(path).read_text())
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-            raise ValueError(f"learned:{path}: not a readable JSON file ({error})") from None
-        try:
+        """The learned trigger in the JSON file ``path``, read by the suite's one JSON reader
+        (:mod:`etsc_envs.core.json_files`; ``ValueError`` naming ``learned:PATH`` and the key
+        for a file that is not one)."""
+        where = f"learned:{path}"
+        data = read_json_file(path, where)
+        with in_file(where):
             return cls.from_json(data)
-        except (KeyError, TypeError, ValueError) as error:
-            raise ValueError(f"learned:{path}: {error}") from None
 
     def policy_for(self, env: Any) -> RuleTrigger:
         """The trigger policy of this point for ``env``: a Gymnasium env of the suite, or a
         PettingZoo parallel env (one policy for every agent, queried with their observations
-        stacked)."""
-        return self.trigger(*policy_interface(env))
+        stacked); ``ValueError`` when ``env`` is another id's."""
+        return self.trigger(*policy_interface(env), env_id=env_id_of(env))
 
     def trigger(
         self,
@@ -562,10 +670,13 @@ class LearnedTrigger:
         action_space: gym.Space,
         observation_names: tuple[str, ...],
         sampling_period_s: float,
+        env_id: str | None = None,
     ) -> RuleTrigger:
-        """The trigger policy of this point for an env of these spaces and names."""
+        """The trigger policy of this point for an env of these spaces and names (of the id
+        ``env_id``, which must be the file's, where known)."""
         from etsc_envs.papers import PAPERS  # the records import the trigger modules
 
+        require_env_id(self.env_id, env_id)
         families = {paper.trigger.__name__: paper.trigger for paper in PAPERS}
         if self.family not in families:
             raise ValueError(f"family must be one of {sorted(families)}, got {self.family!r}")
@@ -578,3 +689,14 @@ class LearnedTrigger:
             observation_names,
             sampling_period_s,
         )
+
+
+def env_id_of(env: Any) -> str | None:
+    """The suite's id of ``env`` (a Gymnasium env made from its id, or the PettingZoo env),
+    or ``None`` for an env built another way."""
+    from etsc_envs.registry import PETTINGZOO_ENV_IDS
+
+    if callable(getattr(env, "observation_space", None)):  # a PettingZoo env
+        return next(iter(PETTINGZOO_ENV_IDS))
+    spec = getattr(env, "spec", None) or getattr(env.unwrapped, "spec", None)
+    return None if spec is None else spec.id.removeprefix("etsc_envs:")
