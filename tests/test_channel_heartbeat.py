@@ -118,8 +118,8 @@ def test_the_decision_runs_the_trigger_in_compiled_intervals_and_deployed():
 @pytest.mark.parametrize(
     ("heartbeat", "message"),
     [
-        (0.0, "heartbeat_instants must be >= 1"),
-        (-1.0, "heartbeat_instants must be a number >= 0"),
+        (0.0, "heartbeat_instants' must be a finite number >= 1"),
+        (-1.0, "heartbeat_instants' must be a finite number >= 1"),
     ],
 )
 def test_a_decision_set_refuses_a_bad_channel_heartbeat(heartbeat, message):

@@ -337,7 +337,7 @@ def test_bad_arguments_name_themselves(kwargs, argument):
 
 def test_factors_outside_the_trigger_range_name_themselves():
     env = gym.make("etsc/ClusterContainmentCentral-v0", horizon_s=0.05)
-    with pytest.raises(ValueError, match=r"actions\[\d+\]: factors\.c must lie in"):
+    with pytest.raises(ValueError, match=r"actions\[\d+\]: key 'factors\.c' must lie in"):
         rule_wrapper(env, factors=(1.0, 2.0))
 
 

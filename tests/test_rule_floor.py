@@ -114,7 +114,7 @@ def test_the_command_line_refuses_a_bad_floor(arguments, message):
 @pytest.mark.parametrize(
     ("action", "message"),
     [
-        ({"point": {"floor_instants": -1.0}}, "floor_instants must be a number >= 0"),
+        ({"point": {"floor_instants": -1.0}}, "floor_instants' must be a finite number >= 0"),
     ],
 )
 def test_a_decision_set_refuses_a_bad_floor(action, message):

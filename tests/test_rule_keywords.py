@@ -86,7 +86,9 @@ def test_keywords_survive_a_save_and_a_load(tmp_path):
 
 def test_a_threshold_outside_the_triggers_range_names_its_factor():
     block = {"actions": [{"kind": "trigger", "point": {"factors": {"a1": -1.0}}}]}
-    with pytest.raises(ValueError, match=r"actions\[0\]: factors\.a1 must be a finite number > 0"):
+    with pytest.raises(
+        ValueError, match=r"actions\[0\]: key 'point\.factors\.a1' must be a finite number > 0"
+    ):
         DecisionSet.from_json(block, ORBIT)
     with pytest.raises(ValueError, match=r"factors\.a1 must be"):
         rule_wrapper(gym.make(ORBIT, horizon_s=0.05), factors=(4.0,), thresholds={"a1": -1.0})

@@ -170,13 +170,13 @@ def config_from_dict(raw: dict[str, Any]) -> SearchConfig:
 def _checked_config(raw: dict[str, Any]) -> SearchConfig:
     """:func:`config_from_dict`'s checks, naming keys as ``key 'search.KEY'``."""
     fields = SearchConfig.__dataclass_fields__
-    raw = require_mapping(raw, "search", fields, ("env_id", "penalty", "start", "search"))
+    raw = require_mapping(raw, "search", fields, ("env_id", "penalty", "search"))
     env_id = require_string(raw["env_id"], "search.env_id", PAPER_IDS)
     family = paper_of(env_id).trigger
     search = require_strings(raw["search"], "search.search", DIMENSIONS)
     if not search:
         raise ValueError(f"key 'search.search' must name at least one of {list(DIMENSIONS)}")
-    start = FamilyPoint.from_json(raw["start"], "search.start")
+    start = FamilyPoint.from_json(raw.get("start", {}), "search.start")
     require_factors(family, start.factors, "search.start.factors")
     counts = {
         key: require_integer(raw.get(key, default), f"search.{key}", least, most)
