@@ -34,10 +34,10 @@ from numpy.testing import assert_allclose, assert_array_equal
 import etsc_envs  # noqa: F401  (registers the ids)
 from baselines import evaluate as evaluate_module
 from baselines import reproduce
-from baselines.cli import parse_assignments
-from baselines.episodes import run_episode, to_jsonable
 from baselines.evaluate import evaluate
 from baselines.reproductions.report import Scenario, claim, metric_row, render, stages
+from etsc_envs.evaluation.arguments import parse_assignments
+from etsc_envs.evaluation.episodes import run_episode, to_jsonable
 from etsc_envs.papers import paper_of
 from etsc_envs.sb3_models import infer_sb3_algorithm, load_sb3
 from etsc_envs.triggers import (

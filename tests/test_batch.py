@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from agents.train.validation_callback import deployment
-from baselines.batch import run_batch, run_batch_in_processes
-from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import SelfTriggeredPolicy, decision_set_v1
+from etsc_envs.evaluation.batch import run_batch, run_batch_in_processes
+from etsc_envs.evaluation.policy_specs import episode_setup
 
 SHORT_HORIZONS = {
     "etsc/AttitudeTracking-v0": 2.0,

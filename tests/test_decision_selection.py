@@ -17,9 +17,9 @@ from agents.train.decision_selection import (
 )
 from agents.train.training import main
 from agents.train.validation_callback import deployment, set_summary
-from baselines.batch import run_batch
-from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import FixedDecision, SelfTriggeredPolicy, decision_set_v1
+from etsc_envs.evaluation.batch import run_batch
+from etsc_envs.evaluation.policy_specs import episode_setup
 from etsc_envs.protocol import scenario_set
 from etsc_envs.triggers.base import RuleTrigger
 from tests.v1_decisions import v1_block

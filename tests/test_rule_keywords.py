@@ -12,9 +12,9 @@ import pytest
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.train.config import config_from_dict
 from agents.train.decision_selection import stand_alone_spec
-from baselines.episodes import run_episode
-from baselines.policy_specs import make_policy
 from etsc_envs.decisions import DecisionSet, decision_set_v1, read_decision_set
+from etsc_envs.evaluation.episodes import run_episode
+from etsc_envs.evaluation.policy_specs import make_policy
 from etsc_envs.triggers import OrbitAttitudeTrigger
 from etsc_envs.triggers.family import scaled_thresholds
 from tests.test_decision_selection import BASE_CONFIG

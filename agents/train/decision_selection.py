@@ -14,8 +14,8 @@ shared by every λ, so its points move along the transmission axis with λ.
 
 A decision that equals a stand-alone trigger when always taken (:func:`stand_alone_spec`:
 "hold N" is the clock every N instants, a plain "paper × f" the rule at f times its
-threshold) runs as that trigger, inside the compiled loop (:mod:`baselines.batch`); the others
-(a heartbeat, a floor, any action of a shielded set) run through the deployed transmit/hold
+threshold) runs as that trigger, inside the compiled loop (:mod:`etsc_envs.evaluation.batch`); the
+others (a heartbeat, a floor, any action of a shielded set) run through the deployed transmit/hold
 policy, one Python call per instant. ``tests/test_decision_selection.py`` checks that both
 paths give the same records.
 """
@@ -31,11 +31,11 @@ from pathlib import Path
 from typing import Any
 
 from agents.train.validation_callback import deployment, set_summary
-from baselines.batch import run_batch
-from baselines.episodes import to_jsonable
-from baselines.policy_specs import EpisodeSetup, episode_setup
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.decisions import DecisionSet, FixedDecision, Hold, SelfTriggeredPolicy
+from etsc_envs.evaluation.batch import run_batch
+from etsc_envs.evaluation.episodes import to_jsonable
+from etsc_envs.evaluation.policy_specs import EpisodeSetup, episode_setup
 from etsc_envs.protocol import scenario_set
 from etsc_envs.triggers.family import FamilyPoint, scaled_thresholds
 

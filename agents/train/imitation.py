@@ -35,8 +35,8 @@ from gymnasium import spaces
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
-from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import DecisionSet, FixedDecision
+from etsc_envs.evaluation.policy_specs import episode_setup
 
 
 def paper_trigger(env_id: str, env_kwargs: dict[str, Any]) -> Any:

@@ -29,5 +29,8 @@ PAPER = Paper(
     # eq. (15) needs 0 < c < 1 (c = 0.6 in the paper): c = 0.15 .. 0.9.
     factors=(0.25, 0.5, 1.0, 1.5),
     headline_metrics=("converge_time_s", "final_containment_err"),
+    cost=(
+        "Σᵢ ‖σᵢ − σ_d,i‖, the followers' summed distance from their containment targets (MRP, rad)"
+    ),
     reproduction="baselines.reproductions.cluster",
 )

@@ -82,6 +82,8 @@ class Paper:
             default.
         headline_metrics: the paper's own metrics shown beside ``mean_cost`` and the
             transmissions when results are judged.
+        cost: what ``mean_cost`` (the mean per-step accuracy cost, before ``cost_scale``)
+            is for its ids: the per-step cost's formula and units, as the env pages give it.
         reproduction: the module (of the checkout, not installed) that reproduces the paper's
             numbers, with ``PAPER``, ``TITLE`` and ``reproduce(plot_dir, progress)``.
     """
@@ -96,6 +98,7 @@ class Paper:
     periodic_every: tuple[int, ...] = PERIODIC_EVERY
     factors: tuple[float, ...] = DEFAULT_FACTORS
     headline_metrics: tuple[str, ...] = ()
+    cost: str = ""
     reproduction: str = ""
 
     @property
