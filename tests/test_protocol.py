@@ -185,6 +185,7 @@ def test_seeds_that_learned_one_policy_keep_the_scenarios_spread() -> None:
 def test_a_verdict_is_met_only_when_the_interval_supports_it() -> None:
     cost = {"iqm": 1.0, "iqm_ci95": [0.97, 1.04]}
     sent = {"iqm": 0.5, "iqm_ci95": [0.45, 0.69]}
+
     def goal(cost: dict, sent: dict, failures: int = 0):
         return goal_verdict({"mean_cost": cost, "transmissions": sent}, failures, 0)
 

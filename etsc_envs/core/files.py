@@ -56,13 +56,24 @@ def _probe(folder: Path, argument: str) -> None:
     os.unlink(probe)
 
 
+def _resolved(path: Path, argument: str) -> Path:
+    """``path`` with its links followed, or ``ValueError`` naming ``argument`` for a loop of
+    symbolic links."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):
+        raise ValueError(
+            f"{argument} cannot be written: {str(path)!r} is a loop of symbolic links"
+        ) from None
+
+
 def require_writable_file(path: str | Path, argument: str) -> Path:
     """``path`` as a :class:`Path` if a file can be written there, else ``ValueError`` naming
     ``argument``: the path (or the target of a link) is a folder, a component of its parent is
     a file, or no file can be created in the folder that would hold it. An existing device or
     FIFO passes (it is written in place)."""
     path = Path(path)
-    target = path.resolve()
+    target = _resolved(path, argument)
     if target.is_dir():
         raise ValueError(f"{argument} must name a file, got the folder {str(path)!r}")
     if target.exists() and not target.is_file():
@@ -77,7 +88,7 @@ def require_writable_folder(path: str | Path, argument: str) -> Path:
     """``path`` as a :class:`Path` if it is, or can become, a folder in which files can be
     created, else ``ValueError`` naming ``argument``."""
     path = Path(path)
-    target = path.resolve()
+    target = _resolved(path, argument)
     if target.exists() and not target.is_dir():
         raise ValueError(f"{argument} must name a folder, got the file {str(path)!r}")
     _probe(target if target.is_dir() else _nearest_existing(target, argument), argument)

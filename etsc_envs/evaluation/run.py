@@ -307,11 +307,17 @@ class CheckedPolicy:
             and bool(np.all((answer == 0) | (answer == 1)))
         )
         if not fits:
+            wrong = answer.ravel()[~((answer.ravel() == 0) | (answer.ravel() == 1))]
+            what = (
+                f"an action of shape {answer.shape}"
+                if answer.size != int(np.prod(expected)) or wrong.size == 0
+                else _shown(wrong[0].item() if wrong.dtype != object else wrong[0])
+            )
+            count = "an observation" if single else f"{observations.shape[0]} observation(s)"
             raise ValueError(
-                f"policy: answered {_shown(actions)} for "
-                f"{'an observation' if single else f'{observations.shape[0]} observations'} "
-                f"of {self.env_id}, whose actions are {self.action_space} (0 hold, 1 transmit"
-                f"{'' if single else ', one per observation'})"
+                f"policy: answered {what} for {count} of {self.env_id}, whose actions are "
+                f"{self.action_space} (0 hold, 1 transmit"
+                f"{'' if single else f'; shape {expected} for this batch'})"
             )
         return answer.reshape(expected).astype(np.int64), state
 
