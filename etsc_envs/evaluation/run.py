@@ -255,31 +255,11 @@ class EvaluationInterrupted(KeyboardInterrupt):
         self.evaluation = evaluation
 
 
-class CallablePolicy:
-    """A plain callable ``observation -> action`` as an SB3-style policy: ``predict`` answers
-    one observation, or a batch of them row by row (one agent's observation each, for a
-    PettingZoo id)."""
-
-    def __init__(self, function: Callable[[np.ndarray], Any], observation_ndim: int) -> None:
-        self.function = function
-        self.observation_ndim = observation_ndim
-
-    def predict(
-        self,
-        observation: np.ndarray,
-        state: Any = None,
-        episode_start: np.ndarray | None = None,
-        deterministic: bool = True,
-    ) -> tuple[np.ndarray, Any]:
-        observations = np.asarray(observation)
-        if observations.ndim == self.observation_ndim:
-            return np.asarray(self.function(observations)), state
-        return np.array([np.asarray(self.function(row)) for row in observations]), state
-
-
 class CheckedPolicy:
-    """A policy of the caller whose every answer is checked against the action space, so that
-    a wrong action is refused with one line naming ``policy`` before the env reads it."""
+    """A policy of the caller — an object with SB3's ``predict``, or a plain callable
+    ``observation -> action`` asked row by row for a batch (one agent's observation each, for
+    a PettingZoo id) — whose every answer is checked against the action space, so that a wrong
+    action is refused with one line naming ``policy`` before the env reads it."""
 
     def __init__(self, policy: Any, action_space: gym.Space, env_id: str) -> None:
         self.policy = policy
@@ -294,11 +274,16 @@ class CheckedPolicy:
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        actions, state = self.policy.predict(
-            observation, state=state, episode_start=episode_start, deterministic=deterministic
-        )
         observations = np.asarray(observation)
         single = observations.ndim == 1
+        if callable(getattr(self.policy, "predict", None)):
+            actions, state = self.policy.predict(
+                observation, state=state, episode_start=episode_start, deterministic=deterministic
+            )
+        elif single:
+            actions = self.policy(observations)
+        else:
+            actions = [np.asarray(self.policy(row)) for row in observations]
         expected = self.action_shape if single else (observations.shape[0], *self.action_shape)
         answer = np.asarray(actions)
         fits = (
@@ -474,9 +459,7 @@ class _Runner:
             return self.setup.make_policy(spec, policy_args)
         if isinstance(given, RuleTrigger) or type(given).__module__.startswith("etsc_envs."):
             return given
-        observation_space, action_space, _ = self.setup.policy_spaces()
-        if not callable(getattr(given, "predict", None)):
-            given = CallablePolicy(given, len(observation_space.shape or ()))
+        _, action_space, _ = self.setup.policy_spaces()
         return CheckedPolicy(given, action_space, self.env_id)
 
     def __call__(self, spec: str, given: Any, policy_args: dict[str, Any]) -> list[dict[str, Any]]:
