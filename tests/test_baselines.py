@@ -347,7 +347,7 @@ SHORT = ["--env-arg", "horizon_s=0.01"]
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--policy", "bogus", *SHORT], "--policy must be one of"),
+        (["--policy", "bogus", *SHORT], "policy must be one of paper"),
         (["--policy", "sb3:/nonexistent/model.zip", *SHORT], "not found"),
         (["--policy", "always", "--env-arg", "horizon_s"], "key=value"),
         (["--policy", "always", "--env-arg", "horizon=1"], "unknown argument"),
@@ -369,7 +369,7 @@ def test_evaluate_command_rejects_unknown_env_and_missing_policy(capsys):
 
 
 def test_evaluate_function_errors():
-    with pytest.raises(ValueError, match="--policy"):
+    with pytest.raises(ValueError, match=r"^policy must be one of"):
         evaluate(ENV_ID, "bogus", env_args={"horizon_s": 0.01})
     with pytest.raises(ValueError, match="not found"):
         evaluate(ENV_ID, "sb3:/nonexistent/model.zip", env_args={"horizon_s": 0.01})
