@@ -11,8 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from baselines.episodes import EpisodeTrace
 from etsc_envs.core.files import atomic_write_bytes
+from etsc_envs.evaluation.episodes import EpisodeTrace
 
 
 def save(figure: plt.Figure, path: Path) -> Path:

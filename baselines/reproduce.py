@@ -5,8 +5,8 @@
 Prints, for every metric a paper reports, the paper's value beside the suite's, then checks the
 paper's qualitative claims. Without ``--paper`` every available reproduction runs. What runs
 now, the share of the planned sampling instants done and an estimate of the time left go to
-standard error (:mod:`baselines.progress`): a bar on a terminal, a line at each run and every
-20 s when redirected.
+standard error (:mod:`etsc_envs.evaluation.progress`): a bar on a terminal, a line at each run and
+every 20 s when redirected.
 """
 
 from __future__ import annotations
@@ -15,11 +15,11 @@ import argparse
 import sys
 from pathlib import Path
 
-from baselines.cli import write_json
-from baselines.progress import JobProgress
 from baselines.reproductions import REPRODUCTIONS
 from baselines.reproductions.report import render
 from etsc_envs.core.files import output_file_argument, output_folder_argument
+from etsc_envs.evaluation.arguments import write_json
+from etsc_envs.evaluation.progress import JobProgress
 
 
 def main(argv: list[str] | None = None) -> int:

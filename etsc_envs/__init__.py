@@ -13,7 +13,7 @@ as ``"parallel"`` and ``"aec"`` envs::
     aec = pettingzoo.make("aec", "etsc/ClusterContainment-v0", max_cycles=1000)
 """
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from etsc_envs.registry import (
     ENV_IDS,
@@ -25,17 +25,37 @@ from etsc_envs.registry import (
     register_all,
 )
 
+if TYPE_CHECKING:
+    from etsc_envs.evaluation import Evaluation, evaluate, leaderboard
+
 __all__ = [
     "ENV_IDS",
     "PETTINGZOO_ENV_IDS",
     "PETTINGZOO_LOOP_IDS",
     "VECTOR_ENTRY_POINTS",
+    "Evaluation",
+    "evaluate",
+    "leaderboard",
     "load_policy",
     "make_aec",
     "make_parallel",
 ]
 
 register_all()
+
+_BENCHMARK = ("Evaluation", "evaluate", "leaderboard")
+"""Names of :mod:`etsc_envs.evaluation` served here, imported on first use so that ``import
+etsc_envs`` (run by every ``gym.make("etsc_envs:...")``) stays light."""
+
+
+def __getattr__(name: str) -> Any:
+    """:func:`etsc_envs.evaluation.evaluate` (the benchmark as a library call),
+    :class:`~etsc_envs.evaluation.Evaluation` and :func:`etsc_envs.evaluation.leaderboard`."""
+    if name in _BENCHMARK:
+        from etsc_envs import evaluation
+
+        return getattr(evaluation, name)
+    raise AttributeError(f"module 'etsc_envs' has no attribute {name!r}")
 
 
 def load_policy(path: str, env: Any) -> Any:

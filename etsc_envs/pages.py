@@ -4,7 +4,8 @@ A page is written by hand except for blocks between ``<!-- generated:KIND -->`` 
 ``<!-- /generated -->``, which this module writes from the environment itself, so they stay
 true: ``summary`` (spaces, period, horizon, how to make it), ``observation`` (every component
 with its bounds and the meaning its problem documents in ``FEATURE_NAMES``) and ``keywords``
-(every constructor keyword with its default and its documentation)::
+(every constructor keyword with its default and its documentation) and ``leaderboard`` (the
+id's test-set rows of ``docs/leaderboard.md``, from the package data, with what its cost is)::
 
     python -m etsc_envs.pages            # rewrite the blocks of every page
     python -m etsc_envs.pages --check    # exit 1 if a page's blocks are not what they would be
@@ -214,8 +215,44 @@ def _args_docs(doc: str) -> dict[str, str]:
     return {name: " ".join(text) for name, text in entries.items()}
 
 
+def leaderboard_block(env_id: str) -> str:
+    """The id's test-set rows of the leaderboard (:func:`etsc_envs.leaderboard`): mean cost and
+    transmissions with 95 % intervals and failures, after what the cost is and its links."""
+    from etsc_envs.evaluation.leaderboard import leaderboard
+    from etsc_envs.papers import paper_of
+
+    def number(value: float) -> str:
+        return f"{value:.0f}" if abs(value) >= 1e4 else f"{value:.4g}"
+
+    def cell(mean: float, interval: tuple[float, float]) -> str:
+        if interval[0] == interval[1]:
+            return number(mean)
+        return f"{number(mean)} [{number(interval[0])}, {number(interval[1])}]"
+
+    lines = [
+        f"`mean_cost` is the mean per-step cost {_markdown(paper_of(env_id).cost)}. The "
+        "whole table (the paper scenario, the records, figures) is the "
+        "[leaderboard](../leaderboard.md); to place your own trigger among these rows, see "
+        "[score your trigger](../benchmark.md).",
+        "",
+        "| trigger | test: mean cost | test: transmissions | test: failures |",
+        "|---|---|---|---|",
+    ]
+    for row in leaderboard(env_id):
+        test = row.test
+        if test is None:
+            continue
+        lines.append(
+            f"| {row.trigger} | {cell(test.cost, test.cost_ci95)} "
+            f"| {cell(test.transmissions, test.transmissions_ci95)} "
+            f"| {test.failures}/{test.episodes} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
 BLOCKS: dict[str, Callable[[str, Any], str]] = {
     "summary": summary_block,
+    "leaderboard": lambda env_id, env: leaderboard_block(env_id),
     "observation": lambda env_id, env: observation_block(env),
     "keywords": lambda env_id, env: keyword_block(env),
 }

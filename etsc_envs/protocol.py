@@ -97,7 +97,8 @@ def scenario_set(name: str, size: int = DEFAULT_SET_SIZE) -> ScenarioSet:
     reserved = RESERVED_SEEDS[name]
     if isinstance(size, bool) or not isinstance(size, int) or not 1 <= size <= len(reserved):
         raise ValueError(
-            f"the size of a scenario set must be an integer in 1..{len(reserved)}, got {size!r}"
+            f"size: the size of a scenario set must be an integer in 1..{len(reserved)}, "
+            f"got {size!r}"
         )
     return ScenarioSet(name, {"randomize": True}, tuple(reserved[:size]))
 

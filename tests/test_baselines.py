@@ -34,10 +34,10 @@ from numpy.testing import assert_allclose, assert_array_equal
 import etsc_envs  # noqa: F401  (registers the ids)
 from baselines import evaluate as evaluate_module
 from baselines import reproduce
-from baselines.cli import parse_assignments
-from baselines.episodes import run_episode, to_jsonable
 from baselines.evaluate import evaluate
 from baselines.reproductions.report import Scenario, claim, metric_row, render, stages
+from etsc_envs.evaluation.arguments import parse_assignments
+from etsc_envs.evaluation.episodes import run_episode, to_jsonable
 from etsc_envs.papers import paper_of
 from etsc_envs.sb3_models import infer_sb3_algorithm, load_sb3
 from etsc_envs.triggers import (
@@ -347,7 +347,7 @@ SHORT = ["--env-arg", "horizon_s=0.01"]
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--policy", "bogus", *SHORT], "--policy must be one of"),
+        (["--policy", "bogus", *SHORT], "policy must be one of paper"),
         (["--policy", "sb3:/nonexistent/model.zip", *SHORT], "not found"),
         (["--policy", "always", "--env-arg", "horizon_s"], "key=value"),
         (["--policy", "always", "--env-arg", "horizon=1"], "unknown argument"),
@@ -369,7 +369,7 @@ def test_evaluate_command_rejects_unknown_env_and_missing_policy(capsys):
 
 
 def test_evaluate_function_errors():
-    with pytest.raises(ValueError, match="--policy"):
+    with pytest.raises(ValueError, match=r"^policy must be one of"):
         evaluate(ENV_ID, "bogus", env_args={"horizon_s": 0.01})
     with pytest.raises(ValueError, match="not found"):
         evaluate(ENV_ID, "sb3:/nonexistent/model.zip", env_args={"horizon_s": 0.01})

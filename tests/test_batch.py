@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from agents.train.validation_callback import deployment
-from baselines.batch import run_batch, run_batch_in_processes
-from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import SelfTriggeredPolicy
+from etsc_envs.evaluation.batch import run_batch, run_batch_in_processes
+from etsc_envs.evaluation.policy_specs import episode_setup
 from tests.rule_sets import rule_set, rule_wrapper
 
 SHORT_HORIZONS = {

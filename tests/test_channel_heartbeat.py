@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.episodes import run_episode
-from baselines.policy_specs import episode_setup
 from etsc_envs.decisions import DecisionSet
+from etsc_envs.evaluation.episodes import run_episode
+from etsc_envs.evaluation.policy_specs import episode_setup
 from etsc_envs.triggers import ClusterContainmentTrigger
 from etsc_envs.triggers.base import (
     channel_heartbeat_trigger_class,

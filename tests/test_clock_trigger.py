@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 from test_batch import SEEDS, SHORT_HORIZONS, assert_same_record
 
-from baselines.batch import run_batch
-from baselines.policy_specs import episode_setup
+from etsc_envs.evaluation.batch import run_batch
+from etsc_envs.evaluation.policy_specs import episode_setup
 from etsc_envs.triggers import ClockTrigger, PeriodicPolicy
 
 EVERY = 7

@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 import etsc_envs
-from baselines.batch import run_batch
 from etsc_envs.decisions import (
     DecisionSet,
     FixedDecision,
@@ -22,6 +21,7 @@ from etsc_envs.decisions import (
     SelfTriggeredPolicy,
     TriggerAction,
 )
+from etsc_envs.evaluation.batch import run_batch
 from etsc_envs.triggers.family import LearnedTrigger
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -12,11 +12,11 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.episodes import run_episode
 from baselines.evaluate import evaluate
-from baselines.policy_specs import make_policy
 from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy
 from etsc_envs.decisions.wrappers import interval_env
+from etsc_envs.evaluation.episodes import run_episode
+from etsc_envs.evaluation.policy_specs import make_policy
 from etsc_envs.papers import paper_of
 from etsc_envs.sb3_models import load_sb3, takes_action_masks
 from etsc_envs.triggers import PeriodicPolicy

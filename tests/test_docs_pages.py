@@ -18,7 +18,7 @@ def test_each_page_shows_its_gif_and_its_blocks_are_current(env_id):
     text = (PAGE_DIR / page_name(env_id)).read_text(encoding="utf-8")
     assert f"]({gif_name(env_id)})" in text
     assert {match.group(2) for match in BLOCK.finditer(text)} == {
-        "summary", "observation", "keywords",
+        "summary", "observation", "keywords", "leaderboard",
     }  # fmt: skip
     assert fill(text, env_id) == text, "run python -m etsc_envs.pages"
 

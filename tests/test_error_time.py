@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.episodes import run_episode
-from baselines.policy_specs import make_policy
+from etsc_envs.evaluation.episodes import run_episode
+from etsc_envs.evaluation.policy_specs import make_policy
 from etsc_envs.papers import rule_of
 from etsc_envs.triggers.inner_formation import (
     AXES,

@@ -14,7 +14,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from baselines.batch import run_batch
+from etsc_envs.evaluation.batch import run_batch
 from etsc_envs.triggers import (
     AsteroidOrbitKeepingTrigger,
     AttitudeTrackingTrigger,

@@ -10,8 +10,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import etsc_envs
-from baselines.episodes import run_parallel_episode
 from etsc_envs.decisions import FollowerDecisionEnv
+from etsc_envs.evaluation.episodes import run_parallel_episode
 from etsc_envs.papers import paper_of
 from etsc_envs.triggers.base import HeartbeatPolicy
 from tests.rule_sets import deployed_policy, rule_follower

@@ -1118,7 +1118,7 @@ EVALUATE_FINDINGS = [
     (["--policy-arg", "heartbeat=abc"], "--policy-arg heartbeat must be an integer >= 1"),
     (["--policy-arg", "foo=1"], "--policy-arg foo: paper on etsc/AttitudeTracking-v0 takes"),
     (["--scenarios", "paper", "--set-size", "-4"], "--set-size"),
-    (["--windows", "10,20"], "--windows: the first window must start inside"),
+    (["--windows", "10,20"], "windows_s: the first window must start inside"),
 ]
 
 

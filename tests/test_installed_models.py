@@ -22,8 +22,8 @@ pytest.importorskip("stable_baselines3")
 from policy_prefix import env_id_of, run_prefix
 
 import etsc_envs
-from baselines.cli import model_spec
-from baselines.policy_specs import episode_setup
+from etsc_envs.evaluation.arguments import model_spec
+from etsc_envs.evaluation.policy_specs import episode_setup
 
 ROOT = Path(__file__).parents[1]
 RUNNER = Path(__file__).with_name("policy_prefix.py")

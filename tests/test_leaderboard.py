@@ -36,7 +36,7 @@ def test_rows_read_the_records_they_name() -> None:
     recorded = record["sets"]["test"]["paper"]["aggregates"]["mean_cost"]
     paper = rows["paper's rule"].sets["test"]
     # the paper's rule on the test set: the same mean and the same bootstrap interval as the
-    # record's own aggregate (both from baselines.statistics.summarize)
+    # record's own aggregate (both from etsc_envs.evaluation.statistics.summarize)
     assert paper.cost["mean"] == recorded["mean"]
     assert paper.cost["mean_ci95"] == recorded["mean_ci95"]
     assert paper.episodes == 64 and paper.failures == 0

@@ -68,7 +68,7 @@ def test_the_front_keeps_only_non_dominated_points() -> None:
 
 @pytest.mark.parametrize("env_id", PAPER_IDS)
 def test_every_sweep_is_accepted_by_its_paper_trigger(env_id: str) -> None:
-    from baselines.policy_specs import episode_setup
+    from etsc_envs.evaluation.policy_specs import episode_setup
 
     setup = episode_setup(env_id, {})
     for args in paper_of(env_id).rule.sweep():

@@ -1,6 +1,6 @@
 """A long job's progress when its standard error is redirected: lines that say what runs, the
-share done and the time left (``baselines.progress``), fed by the episode runners' bars, and
-``python -m baselines.reproduce`` speaking before its first run."""
+share done and the time left (``etsc_envs.evaluation.progress``), fed by the episode runners' bars,
+and ``python -m baselines.reproduce`` speaking before its first run."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import re
 import types
 
 from baselines import reproduce
-from baselines.episodes import instants_bar
-from baselines.progress import JobBar, JobProgress, clock, current_job
 from baselines.reproductions.report import Scenario, stages
+from etsc_envs.evaluation.episodes import instants_bar
+from etsc_envs.evaluation.progress import JobBar, JobProgress, clock, current_job
 
 LINE = re.compile(r"^\[ *(\d+)%\] (.+) \| (\d+:\d\d) elapsed, (about (\d+:\d\d) left|estimating)")
 

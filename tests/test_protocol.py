@@ -9,8 +9,8 @@ import sys
 import numpy as np
 import pytest
 
-from agents.judge.results import verdict
-from baselines.statistics import (
+from agents.judge.results import goal_verdict
+from etsc_envs.evaluation.statistics import (
     aggregate_records,
     paired_ratio,
     proportion_summary,
@@ -185,12 +185,15 @@ def test_seeds_that_learned_one_policy_keep_the_scenarios_spread() -> None:
 def test_a_verdict_is_met_only_when_the_interval_supports_it() -> None:
     cost = {"iqm": 1.0, "iqm_ci95": [0.97, 1.04]}
     sent = {"iqm": 0.5, "iqm_ci95": [0.45, 0.69]}
-    assert verdict(cost, 0, 0, 1.05, sent)["met"]
-    wide = {"iqm": 1.0, "iqm_ci95": [0.9, 1.06]}
-    result = verdict(wide, 0, 0, 1.05, sent)
-    assert not result["met"] and "cost ratio upper bound 1.06" in result["reasons"][0]
-    assert not verdict(cost, 0, 0, 1.05, {"iqm": 0.6, "iqm_ci95": [0.5, 0.71]})["met"]
-    assert not verdict(cost, 1, 0, 1.05, sent)["met"]
+
+    def goal(cost: dict, sent: dict, failures: int = 0):
+        return goal_verdict({"mean_cost": cost, "transmissions": sent}, failures, 0)
+
+    assert goal(cost, sent).met
+    result = goal({"iqm": 1.0, "iqm_ci95": [0.9, 1.06]}, sent)
+    assert not result.met and "cost ratio interval [0.9, 1.06] reaches 1.05" in result.reasons[0]
+    assert not goal(cost, {"iqm": 0.6, "iqm_ci95": [0.5, 0.71]}).met
+    assert not goal(cost, sent, failures=1).met
 
 
 def test_aggregates_cover_cost_transmissions_failures_and_settling() -> None:
@@ -268,8 +271,8 @@ def test_a_cost_where_the_reference_has_none_fails_the_verdict() -> None:
     tied = paired_ratio(np.array([0.0, 0.0, 1.0, 2.0]), reference)
     assert tied["worse_where_reference_zero"] == 0 and tied["iqm"] == 1.0
     sent = {"iqm": 0.5, "iqm_ci95": [0.45, 0.6]}
-    assert verdict(tied, 0, 0, 1.05, sent)["met"]
+    assert goal_verdict({"mean_cost": tied, "transmissions": sent}, 0, 0).met
     worse = paired_ratio(np.array([0.1, 0.0, 1.0, 2.0]), reference)
     assert worse["worse_where_reference_zero"] == 1
-    result = verdict(worse, 0, 0, 1.05, sent)
-    assert not result["met"] and "where the reference's is 0" in result["reasons"][0]
+    result = goal_verdict({"mean_cost": worse, "transmissions": sent}, 0, 0)
+    assert not result.met and "where the reference is 0" in result.reasons[0]

@@ -14,7 +14,7 @@ from stable_baselines3 import PPO
 
 from agents.judge.results import clock_verdict, equal_rate_period, main, markdown, verdict_text
 from agents.train.vector_adapter import make_sb3_vec_env
-from baselines.statistics import paired_ratio
+from etsc_envs.evaluation.statistics import paired_ratio
 
 ENV_ID = "etsc/AttitudeTracking-v0"
 SHORT = {"horizon_s": 0.05}
@@ -52,7 +52,7 @@ def test_results_judges_models_on_the_paper_scenario_and_the_test_set(tmp_path: 
     assert first["periodic"]["mean"]["transmissions"] == -(-50 // every)
     ratio = first["vs_paper"]["mean_cost"]
     assert ratio["iqm_ci95"][0] <= ratio["iqm"] <= ratio["iqm_ci95"][1]
-    assert set(first["goal"]) == {"met", "reasons"}
+    assert set(first["goal"]) == {"outcome", "met", "axes", "reasons", "failures"}
     method = test["method"]
     assert method["claim"] and method["seeds"] == 3
     assert len(method["vs_paper"]["mean_cost"]["per_run"]) == 3
@@ -84,20 +84,31 @@ def fake_result(costs: list[float], transmissions: list[int]) -> dict:
 
 
 @pytest.mark.parametrize(
-    ("periodic_costs", "tie", "text"),
+    ("periodic_costs", "outcome", "text"),
     [
-        ([1.0, 2.0, 3.0, 4.0], True, "tie (the learned trigger transmits as the clock"),
-        ([1.1, 2.2, 3.3, 4.4], False, "**met**"),
-        ([0.9, 1.8, 2.7, 3.6], False, "not met (cost ratio upper bound"),
+        ([1.0, 2.0, 3.0, 4.0], "ties", "ties (cost ratio interval [1, 1] reaches 1)"),
+        ([1.1, 2.2, 3.3, 4.4], "beats", "**beats**"),
+        ([0.9, 1.8, 2.7, 3.6], "loses", "loses (cost ratio interval"),
     ],
 )
-def test_a_learned_trigger_that_is_the_clock_is_a_tie(periodic_costs, tie, text) -> None:
+def test_a_learned_trigger_that_is_the_clock_ties(periodic_costs, outcome, text) -> None:
     learned = fake_result([1.0, 2.0, 3.0, 4.0], [10, 10, 10, 10])
     periodic = fake_result(periodic_costs, [10, 10, 10, 10])
     costs = [[record["mean_cost"] for record in r["episodes"]] for r in (learned, periodic)]
-    result = clock_verdict(paired_ratio(*map(np.array, costs)), learned, periodic)
-    assert result["tie"] is tie
+    result = clock_verdict(paired_ratio(*map(np.array, costs)), 0, 0).to_json()
+    assert result["outcome"] == outcome
     assert verdict_text(result).startswith(text)
+
+
+def test_a_failed_trigger_beats_no_clock_that_failed_too() -> None:
+    """The report's bug: a trigger that failed the paper scenario, beside a clock that failed
+    it too, was printed "beats periodic **met**" (its cut-short cost was lower)."""
+    ratio = paired_ratio(np.array([0.5]), np.array([1.0]))
+    both = clock_verdict(ratio, 1, 1)
+    assert both.outcome == "both fail" and not both.met
+    assert "**" not in verdict_text(both.to_json())
+    assert clock_verdict(ratio, 1, 0).outcome == "loses"
+    assert clock_verdict(ratio, 0, 1).outcome == "beats"
 
 
 def test_seeds_at_one_rate_share_one_run_of_the_clock(tmp_path: Path, monkeypatch) -> None:

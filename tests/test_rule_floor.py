@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
-from baselines.episodes import run_episode
-from baselines.policy_specs import make_policy
 from etsc_envs.decisions import DecisionSet
+from etsc_envs.evaluation.episodes import run_episode
+from etsc_envs.evaluation.policy_specs import make_policy
 from etsc_envs.triggers import OrbitAttitudeTrigger
 from etsc_envs.triggers.base import floored_trigger_class, instants_seconds
 from tests.rule_sets import rule_set, rule_wrapper

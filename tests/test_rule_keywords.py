@@ -11,9 +11,9 @@ import pytest
 
 import etsc_envs  # noqa: F401  (registers the ids)
 from agents.train.config import config_from_dict
-from baselines.episodes import run_episode
-from baselines.policy_specs import make_policy
 from etsc_envs.decisions import DecisionSet
+from etsc_envs.evaluation.episodes import run_episode
+from etsc_envs.evaluation.policy_specs import make_policy
 from etsc_envs.triggers import OrbitAttitudeTrigger
 from etsc_envs.triggers.family import scaled_thresholds
 from tests.rule_sets import BASE_CONFIG, rule_block, rule_set, rule_wrapper

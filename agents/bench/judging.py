@@ -3,13 +3,14 @@ instant.
 
     python -m agents.bench.judging ENV_ID --model PATH [--set-size K] [--repeats R]
 
-:func:`baselines.batch.run_batch` runs a :class:`~etsc_envs.decisions.SelfTriggeredPolicy`
-decision by decision (one model call per decision for the rows still running, each interval in
-one compiled call); any other policy is asked once per sampling instant for the whole batch.
-This command times both on the first ``K`` scenarios of the test set, in one process: the
-model as loaded, and the same policy seen only through its ``predict`` (so that
-:func:`~baselines.batch.run_batch` takes the per-instant path). It checks that both give the same
-transmissions and costs, and prints the median [min-max] wall time of ``R`` runs of each.
+:func:`etsc_envs.evaluation.batch.run_batch` runs a
+:class:`~etsc_envs.decisions.SelfTriggeredPolicy` decision by decision (one model call per decision
+for the rows still running, each interval in one compiled call); any other policy is asked once per
+sampling instant for the whole batch. This command times both on the first ``K`` scenarios of the
+test set, in one process: the model as loaded, and the same policy seen only through its
+``predict`` (so that :func:`~etsc_envs.evaluation.batch.run_batch` takes the per-instant path). It
+checks that both give the same transmissions and costs, and prints the median [min-max] wall time
+of ``R`` runs of each.
 """
 
 from __future__ import annotations
@@ -19,9 +20,9 @@ import statistics
 import time
 from typing import Any
 
-from baselines.batch import run_batch
-from baselines.cli import limit_torch_threads
-from baselines.policy_specs import episode_setup
+from etsc_envs.evaluation.arguments import limit_torch_threads
+from etsc_envs.evaluation.batch import run_batch
+from etsc_envs.evaluation.policy_specs import episode_setup
 from etsc_envs.protocol import scenario_set
 
 

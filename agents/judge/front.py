@@ -29,7 +29,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from baselines.statistics import summarize
+from etsc_envs.evaluation.statistics import summarize
 
 Axes = Callable[[dict[str, Any]], tuple[float, float] | None]
 """A point's (transmissions, mean cost) on one scenario set, ``None`` where it failed there."""

@@ -24,19 +24,20 @@ that makes it:
 The figures draw the paper's threshold sweep, the periodic sweep and the hand menu's front from
 ``<EnvName>_learned_front/pareto.json`` (:attr:`Board.curves`) beside the rows.
 
-Absolute means come with 95 % intervals from :mod:`baselines.statistics`: over the scenarios
-for one run (:func:`~baselines.statistics.summarize`), over runs × scenarios for several
-training seeds (:func:`~baselines.statistics.seeds_summary`, rliable's stratified bootstrap);
-a sweep point keeps the interval its ``pareto.json`` records. The across-id summary treats each
-test scenario of each id as one task, a method's score on it being its mean over its seeds:
-the IQM of the per-scenario cost and transmission ratios to the paper's rule, and the
-probability that the method's cost is below the rule's (ties one half), with bootstrap
-intervals over the tasks (:func:`~baselines.statistics.paired_ratio`).
+Absolute means come with 95 % intervals from :mod:`etsc_envs.evaluation.statistics`: over the
+scenarios for one run (:func:`~etsc_envs.evaluation.statistics.summarize`), over runs × scenarios
+for several training seeds (:func:`~etsc_envs.evaluation.statistics.seeds_summary`, rliable's
+stratified bootstrap); a sweep point keeps the interval its ``pareto.json`` records. The across-id
+summary treats each test scenario of each id as one task, a method's score on it being its mean
+over its seeds: the IQM of the per-scenario cost and transmission ratios to the paper's rule, and
+the probability that the method's cost is below the rule's (ties one half), with bootstrap
+intervals over the tasks (:func:`~etsc_envs.evaluation.statistics.paired_ratio`).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,13 +51,15 @@ import numpy as np
 from matplotlib import ticker
 
 from baselines.plotting import save
-from baselines.statistics import paired_ratio, seeds_summary, summarize
 from etsc_envs.core.files import atomic_write_text, require_writable_file, require_writable_folder
 from etsc_envs.core.json_files import read_json_file, require_mapping
+from etsc_envs.evaluation.statistics import paired_ratio, seeds_summary, summarize
 
 ROOT = Path(__file__).resolve().parents[2]
 RECORDS = ROOT / "docs" / "results"
 OUTPUT = ROOT / "docs" / "leaderboard.md"
+DATA = ROOT / "etsc_envs" / "data" / "leaderboard.json"
+"""The rows as package data (:func:`etsc_envs.leaderboard` reads them)."""
 SETS = ("test", "paper")
 """The test set (64 scenarios) and the paper scenario."""
 
@@ -635,6 +638,17 @@ tuned baseline, not a learned trigger. The report is [`results.md`](results.md).
 """
 
 
+def _units(board: Board) -> list[str]:
+    """What an id's mean cost is (:attr:`etsc_envs.core.paper.Paper.cost`), with its env page."""
+    from etsc_envs.papers import paper_of
+
+    return [
+        f"Mean cost: the mean per-step `mean_cost`, {paper_of(board.env_id).cost}; the env: "
+        f"[{board.name}](envs/{board.name}.md); score a trigger against these rows: "
+        "[benchmark.md](benchmark.md)."
+    ]
+
+
 RL_TRIGGERS = ("per-instant PPO", "self-triggered PPO")
 """The reinforcement-learning rows, of which the README shows the best."""
 
@@ -746,14 +760,55 @@ def render(
     ]
     for board in BOARDS:
         rows = boards[board.env_id]
-        lines += [f"## `{board.env_id}` (paper {board.paper})", "", *_table(rows), ""]
-        lines += ["Commands:", "", *_commands(rows), ""]
+        lines += [f"## `{board.env_id}` (paper {board.paper})", "", *_units(board), ""]
+        lines += [*_table(rows), "", "Commands:", "", *_commands(rows), ""]
         image = f"{link}/{board.name}.png"
         lines += [f"![{board.env_id}: cost against transmissions]({image})", ""]
         if figures is not None:
             sweeps = _load(records / board.curves / "pareto.json")
             figure(board, rows, sweeps, figures / f"{board.name}.png")
     return "\n".join(lines)
+
+
+def _measure_json(measure: Measure | None) -> dict[str, Any] | None:
+    """A row's measure on one set as the package data holds it."""
+    if measure is None:
+        return None
+    return {
+        "mean_cost": {"mean": measure.cost["mean"], "mean_ci95": measure.cost.get("mean_ci95")},
+        "transmissions": {"mean": measure.sent["mean"], "mean_ci95": measure.sent.get("mean_ci95")},
+        "failures": measure.failures,
+        "episodes": measure.episodes,
+    }
+
+
+def leaderboard_data(records: Path, boards: dict[str, list[Row]] | None = None) -> dict[str, Any]:
+    """Every id's rows as data, the numbers of the page (:mod:`etsc_envs.evaluation.leaderboard`
+    reads them): trigger, what it is, record, and per set the mean cost and transmissions with
+    their intervals, failures and episodes; each id with its paper and what its cost is."""
+    from etsc_envs.papers import paper_of
+
+    boards = all_rows(records) if boards is None else boards
+    return {
+        "generated_by": "python -m agents.leaderboard",
+        "page": "docs/leaderboard.md",
+        "ids": {
+            board.env_id: {
+                "paper": board.paper,
+                "cost": paper_of(board.env_id).cost,
+                "rows": [
+                    {
+                        "trigger": row.trigger,
+                        "what": row.what,
+                        "record": row.record.strip("`"),
+                        **{name: _measure_json(row.sets[name]) for name in SETS},
+                    }
+                    for row in boards[board.env_id]
+                ],
+            }
+            for board in BOARDS
+        },
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -766,6 +821,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--out", type=Path, default=OUTPUT, help="the Markdown file (figures beside it)"
     )
+    parser.add_argument("--data", type=Path, default=DATA, help="the rows as JSON package data")
     args = parser.parse_args(argv)
     if not args.records.is_dir():
         parser.error(f"--records must be a folder of judged records, got {args.records}")
@@ -784,10 +840,14 @@ def main(argv: list[str] | None = None) -> int:
     figures = args.out.with_suffix("")
     try:
         require_writable_file(args.out, "--out")
+        require_writable_file(args.data, "--data")
         require_writable_folder(figures, "--out (its figures' folder)")
         boards = all_rows(args.records)
         text = render(args.records, figures, figures.name, boards)
         atomic_write_text(args.out, text)
+        atomic_write_text(
+            args.data, json.dumps(leaderboard_data(args.records, boards), indent=1) + "\n"
+        )
     except ValueError as error:
         parser.error(str(error))
     except OSError as error:
@@ -795,7 +855,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"interrupted; {args.out} was not replaced", file=sys.stderr)
         return 130
-    print(f"wrote {args.out} and {len(BOARDS)} figures in {figures}/", file=sys.stderr)
+    print(f"wrote {args.out}, {len(BOARDS)} figures in {figures}/ and {args.data}", file=sys.stderr)
     if args.records.resolve() == RECORDS:
         readme = with_readme_table(README.read_text(encoding="utf-8"), readme_table(boards))
         atomic_write_text(README, readme)

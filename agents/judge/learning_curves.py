@@ -37,9 +37,9 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
-from baselines.cli import write_json
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
+from etsc_envs.evaluation.arguments import write_json
 
 DEFAULT_COST_TOLERANCE = 1.05
 """The goal's cost tolerance: within 5 % of the paper trigger's ``mean_cost``."""

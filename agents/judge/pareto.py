@@ -70,12 +70,18 @@ from agents.judge.front import (
 )
 from agents.sweep.results import sweep_models
 from agents.train.validation_callback import episode_summary
-from baselines.cli import limit_torch_threads, model_spec, parse_assignments, write_json
-from baselines.evaluate import evaluate, positive_integer
+from baselines.evaluate import evaluate
 from baselines.plotting import save
-from baselines.policy_specs import require_policies
+from etsc_envs.cli import positive_integer
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.core.json_files import read_json_file
+from etsc_envs.evaluation.arguments import (
+    limit_torch_threads,
+    model_spec,
+    parse_assignments,
+    write_json,
+)
+from etsc_envs.evaluation.policy_specs import require_policies
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import DEFAULT_SET_SIZE
 

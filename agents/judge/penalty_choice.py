@@ -31,8 +31,8 @@ from typing import Any
 import numpy as np
 
 from agents.sweep.results import SEARCH_CURVE_FILE, read_sweep
-from baselines.cli import write_json
 from etsc_envs.core.files import output_file_argument
+from etsc_envs.evaluation.arguments import write_json
 
 
 def validation_points(folder: Path) -> tuple[tuple[float, float], tuple[float, float]]:

@@ -10,18 +10,19 @@ it runs the paper's trigger, every ``--model`` (several models are training seed
 method), and, for each model, periodic transmission at that model's own rate (every ``k``
 sampling instants on every channel, ``k`` matching the model's mean transmissions on the set;
 models at the same ``k``, such as seeds that learned the same decisions, share one run of it).
-All scenarios of a set run at once in the native vector env (:mod:`baselines.batch`).
+All scenarios of a set run at once in the native vector env (:mod:`etsc_envs.evaluation.batch`).
 
 Per set and model it reports the paired per-scenario ratios with 95 % bootstrap intervals
-(:mod:`baselines.statistics`) and the goal's verdicts, which hold only when the interval
-supports them:
+(:mod:`etsc_envs.evaluation.statistics`) and two verdicts of
+:func:`etsc_envs.evaluation.verdict.compare` (failures counted first: a trigger that failed an
+episode meets and beats nothing):
 
-* **goal vs the paper** — the upper bound of the cost ratio (IQM of the per-scenario ratios
-  learned / paper) at most :data:`COST_RATIO_MAX`, the upper bound of the transmission ratio at
-  most :data:`TRANSMISSION_RATIO_MAX`, and no more failures than the paper's trigger;
-* **beats periodic** — the upper bound of the cost ratio learned / periodic at the learned rate
-  at most 1, and no more failures than the clock; a learned trigger whose records are the
-  clock's on every scenario is reported as a **tie** (``tie`` in the JSON), not a win.
+* **goal vs the paper** — met when the interval of the cost ratio (IQM of the per-scenario
+  ratios learned / paper) lies below :data:`COST_RATIO_MAX` and that of the transmission ratio
+  below :data:`TRANSMISSION_RATIO_MAX`;
+* **against periodic** — the cost ratio learned / periodic at the learned rate against 1:
+  beats, ties or loses; a learned trigger whose records are the clock's on every scenario
+  ties.
 
 With three or more models the method's verdicts use the IQM over seeds × scenarios with
 rliable's stratified bootstrap interval, and the range of the per-seed IQMs; with fewer, the
@@ -48,12 +49,20 @@ import numpy as np
 
 import etsc_envs
 from agents.sweep.results import finished_trials
-from baselines.cli import limit_torch_threads, model_spec, parse_assignments, write_json
-from baselines.evaluate import evaluate, positive_integer
-from baselines.policy_specs import episode_setup, require_policies
-from baselines.statistics import paired_ratio, seeds_ratio
+from baselines.evaluate import evaluate
+from etsc_envs.cli import positive_integer
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.core.json_files import read_json_file, require_mapping
+from etsc_envs.evaluation import verdict
+from etsc_envs.evaluation.arguments import (
+    limit_torch_threads,
+    model_spec,
+    parse_assignments,
+    write_json,
+)
+from etsc_envs.evaluation.policy_specs import episode_setup, require_policies
+from etsc_envs.evaluation.statistics import paired_ratio, seeds_ratio
+from etsc_envs.evaluation.verdict import Verdict, ratio_axis
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import DEFAULT_SET_SIZE, PROTOCOL_VERSION, SCENARIO_SET_NAMES
 
@@ -93,48 +102,25 @@ def _failures(result: dict[str, Any]) -> int:
     return sum(record["failure"] is not None for record in result["episodes"])
 
 
-def verdict(
-    cost: dict[str, Any],
-    failures: int,
-    reference_failures: int,
-    cost_max: float,
-    transmissions: dict[str, Any] | None = None,
-) -> dict[str, Any]:
-    """Whether the intervals support the goal: the upper bounds of the cost ratio (and of the
-    transmission ratio, when given) within their limits and no more failures than the
-    reference. ``reasons`` names every part that fails."""
-    reasons = []
-    cost_high = cost["iqm_ci95"][1] if cost["iqm_ci95"] else None
-    if cost_high is not None and cost_high > cost_max:
-        reasons.append(f"cost ratio upper bound {_number(cost_high)} > {cost_max}")
-    if cost.get("worse_where_reference_zero"):
-        reasons.append(
-            f"a cost above 0 on {cost['worse_where_reference_zero']} scenario(s) where the "
-            "reference's is 0"
-        )
-    if transmissions is not None:
-        sent_high = transmissions["iqm_ci95"][1] if transmissions["iqm_ci95"] else None
-        if sent_high is None or sent_high > TRANSMISSION_RATIO_MAX:
-            reasons.append(
-                f"transmission ratio upper bound {_number(sent_high)} > {TRANSMISSION_RATIO_MAX}"
-            )
-    if failures > reference_failures:
-        reasons.append(f"{failures} failures > {reference_failures}")
-    return {"met": not reasons, "reasons": reasons}
-
-
-def clock_verdict(
-    vs_periodic: dict[str, Any], learned: dict[str, Any], periodic: dict[str, Any]
-) -> dict[str, Any]:
-    """:func:`verdict` of "at least as accurate as the clock at the learned rate", with
-    ``tie``: whether the learned trigger's records are the clock's on every scenario (same cost
-    and transmissions), a criterion met by identity rather than won."""
-    result = verdict(vs_periodic, _failures(learned), _failures(periodic), 1.0)
-    result["tie"] = all(
-        np.array_equal(_column(learned, key), _column(periodic, key))
-        for key in ("mean_cost", "transmissions")
+def goal_verdict(vs_paper: dict[str, Any], failures: int, paper_failures: int) -> Verdict:
+    """The goal against the paper's rule (:func:`~etsc_envs.evaluation.verdict.compare`): the
+    cost ratio's interval below :data:`COST_RATIO_MAX` and the transmission ratio's below
+    :data:`TRANSMISSION_RATIO_MAX`, failures counted first."""
+    return verdict.compare(
+        failures,
+        paper_failures,
+        {
+            "cost ratio": ratio_axis(vs_paper["mean_cost"], COST_RATIO_MAX),
+            "transmission ratio": ratio_axis(vs_paper["transmissions"], TRANSMISSION_RATIO_MAX),
+        },
     )
-    return result
+
+
+def clock_verdict(cost_ratio: dict[str, Any], failures: int, clock_failures: int) -> Verdict:
+    """Against the clock at the learned rate (:func:`~etsc_envs.evaluation.verdict.compare`):
+    the cost ratio's interval below 1, failures counted first; records that are the clock's on
+    every scenario tie (their ratio's interval is [1, 1])."""
+    return verdict.compare(failures, clock_failures, {"cost ratio": ratio_axis(cost_ratio)})
 
 
 def _compare_set(
@@ -185,14 +171,10 @@ def _compare_set(
                 "periodic": periodic,
                 "vs_paper": vs_paper,
                 "vs_periodic": {"mean_cost": vs_periodic},
-                "goal": verdict(
-                    vs_paper["mean_cost"],
-                    _failures(learned),
-                    _failures(paper),
-                    COST_RATIO_MAX,
-                    vs_paper["transmissions"],
-                ),
-                "beats_periodic": clock_verdict(vs_periodic, learned, periodic),
+                "goal": goal_verdict(vs_paper, _failures(learned), _failures(paper)).to_json(),
+                "beats_periodic": clock_verdict(
+                    vs_periodic, _failures(learned), _failures(periodic)
+                ).to_json(),
             }
         )
     compared: dict[str, Any] = {
@@ -230,13 +212,8 @@ def _method(rows: list[dict[str, Any]], paper: dict[str, Any]) -> dict[str, Any]
         "claim": True,
         "vs_paper": ratios,
         "vs_periodic": {"mean_cost": periodic},
-        "goal": verdict(
-            ratios["mean_cost"], worst, _failures(paper), COST_RATIO_MAX, ratios["transmissions"]
-        ),
-        "beats_periodic": {
-            **verdict(periodic, worst, worst_clock, 1.0),
-            "tie": all(row["beats_periodic"]["tie"] for row in rows),
-        },
+        "goal": goal_verdict(ratios, worst, _failures(paper)).to_json(),
+        "beats_periodic": clock_verdict(periodic, worst, worst_clock).to_json(),
     }
 
 
@@ -353,7 +330,7 @@ def markdown(result: dict[str, Any]) -> str:
                 f"{_ratio_text(row['vs_paper']['mean_cost'])}, transmissions ×paper "
                 f"{_ratio_text(row['vs_paper']['transmissions'])}, cost ×periodic "
                 f"{_ratio_text(row['vs_periodic']['mean_cost'])} (IQM of per-scenario ratios); "
-                f"goal {verdict_text(row['goal'])}; beats periodic "
+                f"goal {goal_text(row['goal'])}; against periodic "
                 f"{verdict_text(row['beats_periodic'])}"
             )
         method = compared["method"]
@@ -362,7 +339,7 @@ def markdown(result: dict[str, Any]) -> str:
                 f"- method over {method['seeds']} seeds (rliable IQM, stratified bootstrap): "
                 f"cost ×paper {_ratio_text(method['vs_paper']['mean_cost'])}, transmissions "
                 f"×paper {_ratio_text(method['vs_paper']['transmissions'])}; goal "
-                f"{verdict_text(method['goal'])}; beats periodic "
+                f"{goal_text(method['goal'])}; against periodic "
                 f"{verdict_text(method['beats_periodic'])}"
             )
         else:
@@ -372,10 +349,13 @@ def markdown(result: dict[str, Any]) -> str:
 
 
 def verdict_text(result: dict[str, Any]) -> str:
-    """A verdict in words: "**met**", "not met (reasons)", or a clock verdict's "tie"."""
-    if result.get("tie"):
-        return "tie (the learned trigger transmits as the clock on every scenario)"
-    return "**met**" if result["met"] else "not met (" + "; ".join(result["reasons"]) + ")"
+    """A verdict's JSON in words (:meth:`~etsc_envs.evaluation.verdict.Verdict.text`)."""
+    return Verdict.from_json(result).text()
+
+
+def goal_text(result: dict[str, Any]) -> str:
+    """The goal's verdict in words: "**met**", or "not met" with its outcome and reasons."""
+    return "**met**" if result["met"] else f"not met: {verdict_text(result)}"
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -318,9 +318,9 @@ def score(
 ) -> dict[str, float]:
     """The mean return, accuracy cost and transmissions of the learned trigger ``learned`` (its
     JSON form) over one episode per seed, all seeds in one batch
-    (:func:`baselines.batch.run_batch`). A module-level function, so that worker processes and
-    Ray tasks can run it."""
-    from baselines.batch import run_batch
+    (:func:`etsc_envs.evaluation.batch.run_batch`). A module-level function, so that worker
+    processes and Ray tasks can run it."""
+    from etsc_envs.evaluation.batch import run_batch
 
     env = (
         etsc_envs.make_parallel(env_id, **env_args)

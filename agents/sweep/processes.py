@@ -10,7 +10,7 @@ whose training had finished is not run again, so the same command continues an i
 unfinished trial starts again from its newest checkpoint where its config saves them.
 
 Workers are spawned, not forked: a forked child of a process that has run torch can deadlock
-in its OpenMP pool (the reason :mod:`baselines.batch` spawns too).
+in its OpenMP pool (the reason :mod:`etsc_envs.evaluation.batch` spawns too).
 """
 
 from __future__ import annotations

@@ -80,9 +80,9 @@ from stable_baselines3 import A2C, DQN, PPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 import etsc_envs
-from baselines.policy_specs import require_env_id
 from etsc_envs.core.files import require_writable_folder
 from etsc_envs.decisions import DecisionSet, make_decision_env
+from etsc_envs.evaluation.policy_specs import require_env_id
 from etsc_envs.protocol import require_training_seeds
 from etsc_envs.sb3_models import require_model_fits
 

@@ -2,7 +2,8 @@
 
 Model selection follows the test protocol (``docs/protocol.md``): the training run is scored
 on the *validation* set only (the test set is for reporting), all its scenarios at once in the
-native vector env (:func:`baselines.batch.run_batch`), and the best-scoring model is kept.
+native vector env (:func:`etsc_envs.evaluation.batch.run_batch`), and the best-scoring model is
+kept.
 """
 
 from __future__ import annotations
@@ -16,11 +17,11 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 from agents.train.model_files import write_model
-from baselines.batch import run_batch
-from baselines.episodes import to_jsonable
-from baselines.policy_specs import EpisodeSetup, episode_setup
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy
+from etsc_envs.evaluation.batch import run_batch
+from etsc_envs.evaluation.episodes import to_jsonable
+from etsc_envs.evaluation.policy_specs import EpisodeSetup, episode_setup
 from etsc_envs.protocol import scenario_set
 from etsc_envs.sb3_models import NormalizedModel, ObservationStatistics
 

@@ -19,7 +19,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
 from baselines.reproductions.report import (
     Scenario,
@@ -28,6 +27,7 @@ from baselines.reproductions.report import (
     run_scenarios,
     scenario_instants,
 )
+from etsc_envs.evaluation.episodes import EpisodeTrace
 from etsc_envs.papers import paper_numbered
 from etsc_envs.triggers.asteroid import PAPER_ALPHA
 

@@ -13,7 +13,6 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
-from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
 from baselines.reproductions.report import (
     Scenario,
@@ -22,6 +21,7 @@ from baselines.reproductions.report import (
     run_scenarios,
     scenario_instants,
 )
+from etsc_envs.evaluation.episodes import EpisodeTrace
 from etsc_envs.papers import paper_numbered
 
 PAPER = "002"

@@ -19,8 +19,6 @@ from typing import Any
 import numpy as np
 
 import etsc_envs
-from baselines.episodes import EpisodeTrace, run_parallel_episode
-from baselines.policy_specs import make_agent_policy
 from baselines.reproductions.cluster_figures import draw_figures
 from baselines.reproductions.report import (
     Scenario,
@@ -31,6 +29,8 @@ from baselines.reproductions.report import (
 )
 from etsc_envs.cluster.env import hull_distance
 from etsc_envs.cluster.params import FIGURE_5_CELLS
+from etsc_envs.evaluation.episodes import EpisodeTrace, run_parallel_episode
+from etsc_envs.evaluation.policy_specs import make_agent_policy
 from etsc_envs.papers import paper_numbered
 
 PAPER = "001"

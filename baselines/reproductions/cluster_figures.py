@@ -7,8 +7,8 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from baselines.episodes import EpisodeTrace
 from baselines.plotting import plot_interevent, save
+from etsc_envs.evaluation.episodes import EpisodeTrace
 from etsc_envs.triggers.cluster import trigger_threshold
 
 AXES = ("x", "y", "z")

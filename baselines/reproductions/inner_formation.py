@@ -15,7 +15,6 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
-from baselines.episodes import EpisodeTrace
 from baselines.plotting import save
 from baselines.reproductions.report import (
     Scenario,
@@ -24,6 +23,7 @@ from baselines.reproductions.report import (
     run_scenarios,
     scenario_instants,
 )
+from etsc_envs.evaluation.episodes import EpisodeTrace
 from etsc_envs.papers import paper_numbered
 from etsc_envs.triggers.inner_formation import AXES, default_thresholds
 

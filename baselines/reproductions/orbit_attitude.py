@@ -23,9 +23,7 @@ import gymnasium as gym
 import matplotlib.pyplot as plt
 import numpy as np
 
-from baselines.episodes import instants_bar
 from baselines.plotting import plot_interevent, save
-from baselines.policy_specs import make_policy
 from baselines.reproductions.report import (
     Scenario,
     claim,
@@ -33,6 +31,8 @@ from baselines.reproductions.report import (
     scenario_instants,
     stages,
 )
+from etsc_envs.evaluation.episodes import instants_bar
+from etsc_envs.evaluation.policy_specs import make_policy
 from etsc_envs.orbit_attitude.closed_loop import disturbance_step
 from etsc_envs.orbit_attitude.dynamics import thruster_outputs
 from etsc_envs.papers import paper_numbered

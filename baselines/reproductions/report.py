@@ -13,9 +13,9 @@ from typing import Any
 import gymnasium as gym
 
 import etsc_envs
-from baselines.episodes import EpisodeTrace, run_episode
-from baselines.policy_specs import make_policy
-from baselines.progress import current_job
+from etsc_envs.evaluation.episodes import EpisodeTrace, run_episode
+from etsc_envs.evaluation.policy_specs import make_policy
+from etsc_envs.evaluation.progress import current_job
 
 TEXT_WIDTH = 100
 """Columns the rendered report fits in."""
@@ -67,9 +67,10 @@ def scenario_instants(env_id: str, scenarios: Iterable[Scenario], **env_args: An
 
 
 def stages(scenarios: Iterable[Scenario], description: str) -> Iterator[Scenario]:
-    """Yield ``scenarios``. Inside an open :class:`~baselines.progress.JobProgress`, tell the
-    job which run starts; otherwise, after each run, write a line saying so to standard error
-    (flushed, so that a long reproduction shows its progress when its output is redirected)."""
+    """Yield ``scenarios``. Inside an open :class:`~etsc_envs.evaluation.progress.JobProgress`,
+    tell the job which run starts; otherwise, after each run, write a line saying so to standard
+    error (flushed, so that a long reproduction shows its progress when its output is
+    redirected)."""
     scenarios = list(scenarios)
     start = time.perf_counter()
     for index, scenario in enumerate(scenarios, start=1):

@@ -27,5 +27,6 @@ PAPER = Paper(
     # inside a running burst: periodic bursts start 200 instants apart at the closest.
     periodic_every=(200, 240, 300, 400, 600, 800, 1200, 1600, 2400, 4800),
     headline_metrics=("min_radius_m", "max_radius_m", "delta_v_mps"),
+    cost=("∫ d² dt over the decision period, d the distance outside the 195–205 m shell (m²·s)"),
     reproduction="baselines.reproductions.asteroid",
 )

@@ -15,5 +15,9 @@ PAPER = Paper(
     ids=("etsc/AttitudeTracking-v0",),
     rule=Rule(AttitudeTrackingTrigger, AttitudeTrackingTrigger.paper_thresholds),
     headline_metrics=("mean_input_norm",),
+    cost=(
+        "⅓ Σᵢ |ωᵢ − ω_d,i| + ¼ Σᵢ |qᵢ − q_d,i|, the integrands of the paper's E_v and E_q, eq. "
+        "(50) (rad/s and quaternion units)"
+    ),
     reproduction="baselines.reproductions.attitude_tracking",
 )

@@ -27,5 +27,8 @@ PAPER = Paper(
     # The paper's trigger updates a follower every few seconds (hundreds of 0.01-s instants).
     periodic_every=(10, 50, 100, 200, 500, 1000, 2000, 5000, 10000),
     headline_metrics=("converge_time_s", "final_containment_err"),
+    cost=(
+        "Σᵢ ‖σᵢ − σ_d,i‖, the followers' summed distance from their containment targets (MRP, rad)"
+    ),
     reproduction="baselines.reproductions.cluster",
 )

@@ -77,6 +77,8 @@ class Paper:
         periodic_every: sampling instants between periodic transmissions swept on a front.
         headline_metrics: the paper's own metrics shown beside ``mean_cost`` and the
             transmissions when results are judged.
+        cost: what ``mean_cost`` (the mean per-step accuracy cost, before ``cost_scale``)
+            is for its ids: the per-step cost's formula and units, as the env pages give it.
         reproduction: the module (of the checkout, not installed) that reproduces the paper's
             numbers, with ``PAPER``, ``TITLE`` and ``reproduce(plot_dir, progress)``.
     """
@@ -90,6 +92,7 @@ class Paper:
     shield: type[Any] | None = None
     periodic_every: tuple[int, ...] = PERIODIC_EVERY
     headline_metrics: tuple[str, ...] = ()
+    cost: str = ""
     reproduction: str = ""
 
     @property

@@ -27,5 +27,6 @@ PAPER = Paper(
     ),
     shield=InnerFormationShield,
     headline_metrics=("ss_pos_err_m", "ss_pos_est_err_m"),
+    cost=("Σᵢ |rᵢ| + Σᵢ |rᵢ − ζᵢ|, the offset and its estimation error (m)"),
     reproduction="baselines.reproductions.inner_formation",
 )

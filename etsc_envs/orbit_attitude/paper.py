@@ -22,5 +22,9 @@ PAPER = Paper(
     ids=("etsc/OrbitAttitudeTracking-v0",),
     rule=Rule(OrbitAttitudeTrigger, _thresholds, sweep_scales=(0.3, 1.0, 3.0, 10.0, 30.0, 100.0)),
     headline_metrics=("ss_att_err_deg", "ss_pos_err_m", "settle_pos_s"),
+    cost=(
+        "¼ Σ log(1 + error/bound) over the attitude, rate, position and velocity errors against"
+        " the paper's steady-state bounds (dimensionless)"
+    ),
     reproduction="baselines.reproductions.orbit_attitude",
 )

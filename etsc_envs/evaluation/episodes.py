@@ -13,7 +13,7 @@ import numpy as np
 from tqdm import tqdm
 
 import etsc_envs  # noqa: F401  (registers the environment ids)
-from baselines.progress import JobBar, current_job
+from etsc_envs.evaluation.progress import JobBar, current_job
 
 
 def window_edges(edges_s: Sequence[float]) -> tuple[float, ...]:
@@ -83,8 +83,9 @@ class EpisodeTrace:
 
 def instants_bar(total: int | None, progress: bool, description: str) -> tqdm | JobBar:
     """A progress bar over ``total`` sampling instants (hidden unless ``progress``), for one
-    episode here and for a batch of them in :mod:`baselines.batch`; inside an open
-    :class:`~baselines.progress.JobProgress`, the job's own bar counts the instants instead."""
+    episode here and for a batch of them in :mod:`etsc_envs.evaluation.batch`; inside an open
+    :class:`~etsc_envs.evaluation.progress.JobProgress`, the job's own bar counts the instants
+    instead."""
     job = current_job()
     if job is not None:
         return JobBar(job)
@@ -117,7 +118,7 @@ def run_episode(
     the trace.
     """
     trace = EpisodeTrace()
-    unwrapped = env.unwrapped
+    unwrapped: Any = env.unwrapped
     sampler: Callable | None = getattr(unwrapped, "state_dict", None) if sample_every else None
     obs, _ = env.reset(seed=seed)
     state, episode_start = None, np.ones(1, dtype=bool)
@@ -134,14 +135,14 @@ def run_episode(
         time_before = unwrapped.time_s
         obs, reward, terminated, truncated, info = env.step(action)
         steps += 1
-        total_return += reward
+        total_return += float(reward)
         trace.time_s.append(info["time_s"])
         trace.cost.append(info["cost"])
         trace.sent.append(int(info["transmitted"]))
         if info["transmitted"]:
             trace.transmission_times_s.append(time_before)
             trace.transmission_actions.append(np.asarray(action))
-        if sampler is not None and steps % sample_every == 0:
+        if sampler is not None and sample_every and steps % sample_every == 0:
             trace.samples.append(sampler())
         if steps % 1000 == 0:
             bar.update(1000)
@@ -209,7 +210,7 @@ def run_parallel_episode(
         if bits.any():
             trace.transmission_times_s.append(time_before)
             trace.transmission_actions.append(bits.copy())
-        if sampler is not None and steps % sample_every == 0:
+        if sampler is not None and sample_every and steps % sample_every == 0:
             trace.samples.append(sampler())
         if steps % 1000 == 0:
             bar.update(1000)
@@ -237,7 +238,7 @@ def mean_record(records: list[dict[str, Any]]) -> dict[str, Any]:
         values = [record.get(key) for record in records]
         if key == "seed" or not all(isinstance(v, int | float) for v in values):
             continue
-        mean[key] = float(np.mean(values))
+        mean[key] = float(np.mean(np.asarray(values, dtype=float)))
     mean["failures"] = sum(record.get("failure") is not None for record in records)
     if all(isinstance(record.get("agents"), dict) for record in records):
         mean["agents"] = {

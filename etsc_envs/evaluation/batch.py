@@ -7,8 +7,8 @@ asked once per instant for the whole batch — for a PettingZoo id, once for eve
 every copy (``K × N`` observations, agent-minor, the layout of
 :class:`agents.train.vector_adapter.SharedPolicyVecEnv`). Sub-environment ``j`` reset with seed
 ``s_j`` is the single environment reset with ``s_j`` (the vector env's contract), so a
-scenario's record here equals :func:`baselines.episodes.run_episode`'s (or
-:func:`~baselines.episodes.run_parallel_episode`'s) for the same seed, key for key; only
+scenario's record here equals :func:`etsc_envs.evaluation.episodes.run_episode`'s (or
+:func:`~etsc_envs.evaluation.episodes.run_parallel_episode`'s) for the same seed, key for key; only
 ``wall_time_s`` differs: it is the batch's wall time divided by ``K``. ``tests/test_batch.py``
 compares the two paths for every id.
 
@@ -31,13 +31,18 @@ hand-off between stepping threads (about 80 µs an instant, measured on paper 00
 and runs the policy's ``predict`` in parallel too. Rows never interact, so the records are
 those of :func:`run_batch` (``tests/test_batch.py``); ``wall_time_s`` is each part's wall time
 divided by its rows. Workers are spawned, not forked: a fork of a process whose PyTorch had
-started its OpenMP threads deadlocks in the child's first matrix product.
+started its OpenMP threads deadlocks in the child's first matrix product. A worker dies with
+its parent (:func:`die_with_parent`): a killed evaluation leaves no worker stepping on.
 """
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import os
+import signal
+import sys
+import threading
 import time
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -48,11 +53,18 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 
 import etsc_envs
-from baselines.episodes import instants_bar
 from etsc_envs.core.multi_agent import agent_observation_index
 from etsc_envs.core.vector_env import available_cores
 from etsc_envs.decisions import SelfTriggeredPolicy, run_decision_interval
+from etsc_envs.evaluation.episodes import instants_bar
 from etsc_envs.triggers.base import RuleTrigger
+
+PARENT_WATCH_S = 1.0
+"""Seconds between a worker's checks that its parent lives, where the system cannot kill it
+with its parent."""
+
+PR_SET_PDEATHSIG = 1
+"""Linux's ``prctl`` option: the signal a process gets when its parent dies."""
 
 PROGRESS_EVERY = 1000
 """Sampling instants between progress-bar updates."""
@@ -96,7 +108,7 @@ def run_batch(
     Args:
         env_id: a Gymnasium or PettingZoo id of the suite.
         policy: anything with an SB3-style batched ``predict`` (for a PettingZoo id, one policy
-            for every agent, as :func:`baselines.policy_specs.make_agent_policy` builds).
+            for every agent, as :func:`etsc_envs.evaluation.policy_specs.make_agent_policy` builds).
         seeds: the reset seed of each scenario.
         env_args: keywords of every scenario's env.
         progress: show a progress bar over the sampling instants.
@@ -131,12 +143,36 @@ def run_batch_in_processes(
     parts = [part.tolist() for part in np.array_split(np.array(seeds), processes) if part.size]
     cores = available_cores()
     work = (env_id, policy_spec, dict(policy_args), dict(env_args or {}), description)
-    with ProcessPoolExecutor(len(parts), mp_context=multiprocessing.get_context("spawn")) as pool:
+    with ProcessPoolExecutor(
+        len(parts),
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=die_with_parent,
+        initargs=(os.getpid(),),
+    ) as pool:
         futures = [
             pool.submit(_run_part, work, part, cores[index % len(cores)], progress and index == 0)
             for index, part in enumerate(parts)
         ]
         return [record for future in futures for record in future.result()]
+
+
+def die_with_parent(parent: int) -> None:
+    """Make this worker process end when the process ``parent`` does (a ``ProcessPoolExecutor``
+    initializer): on Linux the kernel sends it SIGKILL (``prctl(PR_SET_PDEATHSIG)``), elsewhere
+    a daemon thread exits it once its parent is gone, checking every :data:`PARENT_WATCH_S`."""
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
+            if os.getppid() != parent:  # the parent died before the call
+                os._exit(1)
+            return
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_WATCH_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="parent-watch", daemon=True).start()
 
 
 def _run_part(
@@ -147,8 +183,8 @@ def _run_part(
 ) -> list[dict[str, Any]]:
     """One worker's share of :func:`run_batch_in_processes`, on ``core`` alone (so that its
     vector env steps with one thread and PyTorch with one)."""
-    from baselines.cli import limit_torch_threads
-    from baselines.policy_specs import episode_setup
+    from etsc_envs.evaluation.arguments import limit_torch_threads
+    from etsc_envs.evaluation.policy_specs import episode_setup
 
     env_id, policy_spec, policy_args, env_args, description = work
     if hasattr(os, "sched_setaffinity"):

@@ -42,7 +42,7 @@ IQM_TRIM = 0.25
 """The interquartile mean drops this fraction of the values at each end."""
 
 
-def iqm(values: np.ndarray, axis: int | None = -1) -> np.ndarray:
+def iqm(values: np.ndarray, axis: int = -1) -> np.ndarray:
     """The interquartile mean: the mean of the middle half (``scipy.stats.trim_mean``)."""
     return stats.trim_mean(values, IQM_TRIM, axis=axis)
 
@@ -87,17 +87,17 @@ def summarize(values: Sequence[float]) -> dict[str, Any]:
 def proportion_summary(flags: Sequence[bool]) -> dict[str, Any]:
     """Count and rate of the true ``flags`` (failed, settled, ...) with the exact
     (Clopper–Pearson) 95 % interval of the rate."""
-    flags = np.asarray(flags, dtype=bool)
-    if flags.size == 0:
+    marked = np.asarray(flags, dtype=bool)
+    if marked.size == 0:
         raise ValueError("flags must name at least one episode")
-    count = int(flags.sum())
-    interval = stats.binomtest(count, int(flags.size)).proportion_ci(
+    count = int(marked.sum())
+    interval = stats.binomtest(count, int(marked.size)).proportion_ci(
         confidence_level=CONFIDENCE, method="exact"
     )
     return {
-        "n": int(flags.size),
+        "n": int(marked.size),
         "count": count,
-        "rate": count / flags.size,
+        "rate": count / marked.size,
         "rate_ci95": [float(interval.low), float(interval.high)],
     }
 
@@ -110,7 +110,9 @@ def _improvement(a: np.ndarray, b: np.ndarray, axis: int = -1) -> np.ndarray:
     return np.mean((a < b) + 0.5 * (a == b), axis=axis)
 
 
-def paired_ratio(candidate: Sequence[float], reference: Sequence[float]) -> dict[str, Any]:
+def paired_ratio(
+    candidate: Sequence[float] | np.ndarray, reference: Sequence[float] | np.ndarray
+) -> dict[str, Any]:
     """``candidate`` against ``reference`` on the same scenarios (lower is better).
 
     Returns the per-scenario ratios' IQM and median (``iqm``, ``iqm_ci95``, ``median``), the

@@ -9,8 +9,8 @@ the time left at the job's mean rate so far::
     [ 12%] paper 000: run 2/4 (P2) | 0:41 elapsed, about 5:02 left
 
 While a job is open (``with JobProgress(...)``), the episode runners' progress bars
-(:func:`baselines.episodes.instants_bar`) report their instants to it instead of drawing bars
-of their own, so code deep inside a job reports its progress without being handed the job.
+(:func:`etsc_envs.evaluation.episodes.instants_bar`) report their instants to it instead of drawing
+bars of their own, so code deep inside a job reports its progress without being handed the job.
 """
 
 from __future__ import annotations
@@ -132,7 +132,8 @@ class JobProgress:
 
 class JobBar:
     """An episode's progress bar inside an open job: its ``update`` counts instants for the
-    job (the interface of tqdm that :func:`baselines.episodes.instants_bar` callers use)."""
+    job (the interface of tqdm that :func:`etsc_envs.evaluation.episodes.instants_bar` callers
+    use)."""
 
     def __init__(self, job: JobProgress) -> None:
         self.job = job

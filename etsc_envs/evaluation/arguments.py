@@ -9,8 +9,8 @@ from typing import Any
 
 import yaml
 
-from baselines.episodes import to_jsonable
 from etsc_envs.core.files import atomic_write_text
+from etsc_envs.evaluation.episodes import to_jsonable
 
 
 def limit_torch_threads() -> None:

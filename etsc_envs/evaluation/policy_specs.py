@@ -14,12 +14,12 @@ from typing import Any, NamedTuple
 import gymnasium as gym
 
 import etsc_envs
-from baselines.episodes import run_episode, run_parallel_episode
 from etsc_envs.core.compiled_loop import always_accepts
 from etsc_envs.core.loop_env import EventTriggeredEnv
 from etsc_envs.core.paper import RULE_NAMES
 from etsc_envs.core.validation import require_int_at_least
 from etsc_envs.decisions.policy import sb3_policy
+from etsc_envs.evaluation.episodes import run_episode, run_parallel_episode
 from etsc_envs.papers import ids_with_rule, rule_of
 from etsc_envs.triggers import AlwaysPolicy, PeriodicPolicy, SwitchedPeriodicPolicy
 from etsc_envs.triggers.base import (
@@ -30,6 +30,9 @@ from etsc_envs.triggers.base import (
     timed_rule_class,
 )
 from etsc_envs.triggers.family import LearnedTrigger
+
+NAMED_POLICIES = ("paper", "error_time", "periodic", "always")
+"""The policy specs that name a rule or a clock rather than a file."""
 
 POLICY_CHOICES = "paper | error_time | periodic | always | sb3:PATH_TO_ZIP | learned:PATH"
 """An ``sb3:`` model with ``NAME_decisions.json`` beside its zip takes self-triggered decisions
@@ -88,14 +91,15 @@ def check_policy_arguments(spec: str, policy_args: dict[str, Any], env_id: str) 
 
 def make_policy(spec: str, env: gym.Env, policy_args: dict[str, Any], env_id: str) -> Any:
     """The policy named by ``spec`` (see :data:`POLICY_CHOICES`) for ``env``."""
+    unwrapped: Any = env.unwrapped
     return _policy_for(
         spec,
         env.observation_space,
         env.action_space,
-        lambda: env.unwrapped.observation_names,
+        lambda: unwrapped.observation_names,
         policy_args,
         env_id,
-        lambda: env.unwrapped,
+        lambda: unwrapped,
     )
 
 
@@ -131,7 +135,7 @@ class EpisodeSetup(NamedTuple):
     make_policy: Callable[[str, dict[str, Any]], Any]
     """``(spec, policy_args) -> policy`` (for a PettingZoo id, one policy serves all agents)."""
     run: Callable[..., tuple[dict[str, Any], Any]]
-    """:func:`~baselines.episodes.run_episode` or its PettingZoo form."""
+    """:func:`~etsc_envs.evaluation.episodes.run_episode` or its PettingZoo form."""
 
     def policy_spaces(self) -> tuple[gym.Space, gym.Space, tuple[str, ...]]:
         """The observation space, action space and observation names a policy acts with
@@ -190,7 +194,7 @@ def _policy_for(
 ) -> Any:
     """The policy named by ``spec`` for the given spaces (the names and the env's ``loop`` are
     read only if needed). ``periodic`` is :class:`ClockTrigger` — :class:`PeriodicPolicy`'s
-    decisions as a rule that the compiled loop runs (:mod:`baselines.batch`) — where the
+    decisions as a rule that the compiled loop runs (:mod:`etsc_envs.evaluation.batch`) — where the
     receiver takes every transmission; where it may refuse one (paper 003's burst in
     progress), the time since transmission no longer counts the clock's instants, and
     ``periodic`` is the counter-based :class:`PeriodicPolicy`. ``periodic`` with
