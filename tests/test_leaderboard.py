@@ -18,6 +18,10 @@ def test_committed_leaderboard_is_what_the_records_give() -> None:
     text = leaderboard.render(leaderboard.RECORDS, None, leaderboard.OUTPUT.with_suffix("").name)
     committed = leaderboard.OUTPUT.read_text(encoding="utf-8")
     assert text == committed, "docs/leaderboard.md is stale: run python -m agents.leaderboard"
+    data = json.loads(leaderboard.DATA.read_text(encoding="utf-8"))
+    assert data == json.loads(json.dumps(leaderboard.leaderboard_data(leaderboard.RECORDS))), (
+        "etsc_envs/data/leaderboard.json is stale: run python -m agents.leaderboard"
+    )
 
 
 def test_every_figure_of_the_page_is_committed() -> None:
