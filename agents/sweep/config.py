@@ -11,7 +11,9 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
 * ``learner: train`` — what a trial runs: ``train`` (one ``agents.train`` run, ``base`` a
   training config) or ``search`` (one ``agents.search`` run, ``base`` a search config of
   ``configs/search/``, whose keys ``overrides`` and ``grid`` then set: a front of the learned
-  trigger family over ``penalty`` × ``seed``); a search sweep is a ``front``;
+  trigger family over ``penalty`` × ``seed``); or ``oracle`` (one clairvoyant-schedule run
+  of :mod:`agents.oracle`, ``base`` a config of ``configs/oracle/`` whose ``grid`` runs
+  ``scenario`` over a set); a search or oracle sweep is a ``front``;
 * ``kind`` — ``front`` (the trials form a reported front, e.g. transmission penalty × seed:
   every trial runs to its end, so neither a scheduler nor a search algorithm is allowed) or
   ``search`` (a hyperparameter search, which may use them);
@@ -58,6 +60,7 @@ from typing import Any
 
 import yaml
 
+from agents.oracle.run import OracleConfig, oracle_config_from_dict
 from agents.search.cma_es import SearchConfig
 from agents.search.cma_es import config_from_dict as search_config_from_dict
 from agents.sweep.results import EVALUATION_METRICS, METRICS, SETTINGS_FILE, TRIALS_DIR
@@ -71,7 +74,7 @@ from agents.train.config import (
 from etsc_envs.core.files import atomic_write_text
 
 KINDS = ("front", "search")
-LEARNERS = ("train", "search")
+LEARNERS = ("train", "search", "oracle")
 SCHEDULERS = ("asha",)
 SEARCH_ALGORITHMS = ("optuna",)
 MODES = ("min", "max")
@@ -222,12 +225,14 @@ class SweepConfig:
 
     def trial_config(
         self, values: Mapping[str, Any], out_dir: str | Path
-    ) -> TrainConfig | SearchConfig:
-        """The validated config of the trial with the swept ``values``: a training config, or
-        a search config for ``learner: search``."""
+    ) -> TrainConfig | SearchConfig | OracleConfig:
+        """The validated config of the trial with the swept ``values``: a training config, a
+        search config for ``learner: search``, a clairvoyant-schedule run's for ``oracle``."""
         raw = self.trial_mapping(values, out_dir)
         if self.learner == "search":
             return search_config_from_dict(raw)
+        if self.learner == "oracle":
+            return oracle_config_from_dict(raw)
         return config_from_dict(raw)
 
 
@@ -246,12 +251,16 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
     values = {**OPTIONAL_SWEEP_DEFAULTS, **raw}
     kind = _check_choice("kind", values["kind"], KINDS)
     learner = _check_choice("learner", values["learner"], LEARNERS)
-    if learner == "search" and kind != "front":
+    if learner != "train" and kind != "front":
         raise ValueError(
-            "sweep key 'kind' must be 'front' with learner 'search' (its trials are searches "
-            "over penalty x seed, each run to its end)"
+            f"sweep key 'kind' must be 'front' with learner {learner!r} (its trials are "
+            "searches over a grid, each run to its end)"
         )
-    check_key = _check_search_key if learner == "search" else _check_training_key
+    check_key = {
+        "train": _check_training_key,
+        "search": _check_search_key,
+        "oracle": _check_oracle_key,
+    }[learner]
     base = _load_base(values["base"])
     overrides = _check_mapping("overrides", values["overrides"])
     for key, value in overrides.items():
@@ -348,6 +357,14 @@ def _check_training_key(section: str, key: Any) -> str:
             f"sweep key {section!r}: unknown training-config key {key!r}; allowed: {allowed}, "
             f"or {list(NESTED_TRAINING_KEYS)} followed by '.name'"
         )
+    return key
+
+
+def _check_oracle_key(section: str, key: Any) -> str:
+    """A key of a clairvoyant-schedule run (:class:`agents.oracle.run.OracleConfig`)."""
+    allowed = list(OracleConfig.__dataclass_fields__)
+    if key not in allowed:
+        raise ValueError(f"sweep key {section!r}: unknown oracle key {key!r}; allowed: {allowed}")
     return key
 
 

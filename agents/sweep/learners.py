@@ -1,6 +1,6 @@
-"""What one trial of a sweep runs, by the sweep's ``learner``: an ``agents.train`` run or an
-``agents.search`` run, each into the trial's folder and each continuing where an interrupted
-start of the same trial stopped.
+"""What one trial of a sweep runs, by the sweep's ``learner``: an ``agents.train`` run, an
+``agents.search`` run (each continuing where an interrupted start of the same trial stopped)
+or an ``agents.oracle`` run, each into the trial's folder.
 
 Both the Ray path (:mod:`agents.sweep.trial`) and the worker-process path
 (:mod:`agents.sweep.processes`) run a trial through :func:`run_trial`.
@@ -15,6 +15,7 @@ from typing import Any
 import yaml
 from stable_baselines3.common.callbacks import BaseCallback
 
+from agents.oracle.run import OracleConfig, run_oracle
 from agents.search.cma_es import Evaluator, SearchConfig, run_search
 from agents.sweep.config import SweepConfig
 from agents.sweep.results import CONFIG_FILE, EVALUATIONS_FILE
@@ -35,6 +36,9 @@ def run_trial(
     training. A search trial replays its recorded generations and continues (its candidates
     are scored one after another in this process: the sweep runs trials in parallel)."""
     config = sweep.trial_config(values, folder)
+    if isinstance(config, OracleConfig):  # a finished one is not run again
+        run_oracle(config, folder)
+        return
     if isinstance(config, SearchConfig):
         folder.mkdir(parents=True, exist_ok=True)
         mapping = sweep.trial_mapping(values, folder)

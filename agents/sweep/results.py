@@ -36,6 +36,8 @@ CONFIG_FILE = "config.yaml"
 LEARNED_FILE = "learned.json"
 """A search trial's learned trigger (``agents.search``), written last."""
 SEARCH_CURVE_FILE = "curve.json"
+ORACLE_FILE = "oracle.json"
+"""A clairvoyant-schedule trial's record (``agents.oracle``), written last."""
 STATUSES = ("finished", "failed", "incomplete")
 
 METRICS = (
@@ -92,6 +94,14 @@ def final_scores(folder: str | Path) -> dict[str, Any] | None:
     mean return of its last episodes) and ``evaluations.json``, or of a finished search (its
     env steps and the chosen trigger's validation return, from ``curve.json``); ``None`` if it
     did not finish."""
+    if (Path(folder) / ORACLE_FILE).is_file():
+        oracle = json.loads((Path(folder) / ORACLE_FILE).read_text(encoding="utf-8"))
+        return {
+            "trigger_transmissions": oracle["trigger"]["transmissions"],
+            "fewest_transmissions": oracle["fewest_transmissions"]["transmissions"],
+            "trigger_mean_cost": oracle["trigger"]["mean_cost"],
+            "least_mean_cost": oracle["least_cost"]["mean_cost"],
+        }
     if (Path(folder) / LEARNED_FILE).is_file():
         search = json.loads((Path(folder) / SEARCH_CURVE_FILE).read_text(encoding="utf-8"))
         return {
@@ -143,10 +153,11 @@ class SweepTrial:
 
 def trial_finished(folder: str | Path) -> bool:
     """Whether the trial in ``folder`` finished: ``agents.train`` writes its summary last,
-    after the model, and ``agents.search`` its learned trigger after its last generation."""
+    after the model, ``agents.search`` its learned trigger after its last generation and
+    ``agents.oracle`` its record at its end."""
     folder = Path(folder)
     trained = (folder / MODEL_FILE).is_file() and (folder / TRAIN_SUMMARY_FILE).is_file()
-    return trained or (folder / LEARNED_FILE).is_file()
+    return trained or (folder / LEARNED_FILE).is_file() or (folder / ORACLE_FILE).is_file()
 
 
 def trial_status(folder: Path, error: str | None) -> str:
