@@ -11,8 +11,10 @@ The settings are the keys of ``configs/oracle/<problem>.yaml`` (a sweep's ``base
 * ``budget_episodes`` — instants the search may simulate, in episodes of the id (each
   objective's search gets 3/8 from the trigger's schedule and 1/8 from the clock's,
   :data:`agents.oracle.search.START_SHARES`);
-* ``tail`` — instants of the schedule past a changed channel's next send that a move is
-  screened over, or ``null`` to screen each move to the horizon (exact, for short episodes).
+* ``tail`` — how a move is judged: ``null``, followed by the trigger to the horizon and run
+  exactly (:func:`agents.oracle.search.improve_by_rollout`; for short episodes); an integer,
+  screened over the changed channel's next send and ``tail`` instants of the schedule beyond
+  (:func:`agents.oracle.search.improve`; for long multi-channel ones).
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from agents.oracle.schedule import ScheduleRun, trigger_schedule
+from agents.oracle.schedule import ScheduleRun
 from agents.oracle.search import clairvoyant
 from agents.sweep.results import ORACLE_FILE
 from etsc_envs.core.files import atomic_write_text
@@ -92,7 +94,7 @@ def run_oracle(config: OracleConfig, out: str | Path) -> dict[str, Any]:
     trigger = LearnedTrigger.load(config.trigger).policy_for(run.env)
     found = clairvoyant(
         run,
-        trigger_schedule(run, trigger),
+        trigger,
         round(config.budget_episodes * run.n_steps),
         config.tail,
     )

@@ -36,7 +36,9 @@ class Schedule:
 
     def __post_init__(self) -> None:
         instants = np.asarray(self.instants, dtype=np.int64)
-        masks = np.asarray(self.masks, dtype=np.int64).reshape(len(instants), -1)
+        masks = np.asarray(self.masks, dtype=np.int64)
+        if masks.ndim != 2 or len(masks) != len(instants):
+            raise ValueError(f"masks must be (instants, channels), got shape {masks.shape}")
         keep = masks.any(axis=1)
         instants, masks = instants[keep], masks[keep]
         if np.any(np.diff(instants) <= 0):
@@ -185,6 +187,69 @@ class ScheduleRun:
         mean_cost = float(self.env.episode_metrics()["mean_cost"])
         return Outcome(schedule, cost, failed, mean_cost, states, costs)
 
+    def follow(self, trigger: RuleTrigger) -> tuple[list[int], list[np.ndarray], float, bool]:
+        """From the restored state to the horizon, the decisions of ``trigger`` (a rule or
+        family point for this env), interval by interval in compiled calls
+        (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_rule_interval`): the instants
+        it sent at, the channels it sent there, the summed cost and whether it failed."""
+        env = self.env
+        instants: list[int] = []
+        masks: list[np.ndarray] = []
+        cost = 0.0
+        while env.step_index < self.n_steps:
+            before = env.transmissions.copy()
+            start = env.step_index
+            _, reward, terminated, _, _, steps_run = env.run_rule_interval(trigger, self.n_steps)
+            self.steps += steps_run
+            cost -= reward
+            sent = (env.transmissions - before).astype(np.int64)
+            if sent.any():
+                instants.append(start)
+                masks.append(sent)
+            if terminated:
+                return instants, masks, cost, True
+        return instants, masks, cost, False
+
+    def continued(
+        self,
+        base: Outcome,
+        first: int,
+        sends: list[tuple[int, np.ndarray]],
+        trigger: RuleTrigger,
+    ) -> tuple[Schedule, float] | None:
+        """``base``'s schedule up to its instant index ``first``, then ``sends`` (instants at
+        or after that instant, in order, each ``(instant, channels)``; a mask of zeros holds
+        through its instant), then ``trigger``'s decisions from the instant after the last to
+        the horizon: the schedule and its exact summed cost, or ``None`` if it fails. A move
+        followed by the trigger: the rest of the episode reacts to the change, as the trigger
+        would."""
+        self.restore(base.states[first])
+        now = int(base.schedule.instants[first])
+        cost = float(base.costs_before[first])
+        instants = list(base.schedule.instants[:first])
+        masks = list(base.schedule.masks[:first])
+        hold = np.zeros(self.n_channels, dtype=np.int64)
+        for instant, mask in sends:
+            for channels, length in ((hold, instant - now), (mask, 1)):
+                if length > 0:
+                    part, failed = self._interval(channels, length)
+                    cost += part
+                    if failed:
+                        return None
+            now = instant + 1
+            if mask.any():
+                instants.append(instant)
+                masks.append(mask)
+        if now < self.n_steps:
+            later_instants, later_masks, part, failed = self.follow(trigger)
+            if failed:
+                return None
+            cost += part
+            instants += later_instants
+            masks += later_masks
+        masks_array = np.array(masks, dtype=np.int64).reshape(-1, self.n_channels)
+        return Schedule(np.array(instants, dtype=np.int64), masks_array), cost
+
     def window_cost(self, base: Outcome, changed: Schedule, first: int, stop_index: int) -> float:
         """The summed cost over ``[start, stop)`` of ``changed`` — ``base``'s schedule changed
         at or after ``base``'s instant index ``first`` (instant ``start``) and before its
@@ -208,21 +273,6 @@ def trigger_schedule(run: ScheduleRun, trigger: RuleTrigger) -> Schedule:
     """The schedule ``trigger`` (a rule or family point for ``run``'s env) sends on ``run``'s
     scenario: its decisions, interval by interval in compiled calls
     (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_rule_interval`)."""
-    env = run.env
     run.restore(run.initial)
-    instants, masks = [], []
-    while True:
-        before = env.transmissions.copy()
-        start = env.step_index
-        _, _, terminated, truncated, _, steps_run = env.run_rule_interval(trigger, run.n_steps)
-        run.steps += steps_run
-        sent = (env.transmissions - before).astype(np.int64)
-        if sent.any():
-            instants.append(start)
-            masks.append(sent)
-        if terminated or truncated:
-            break
-    return Schedule(
-        np.array(instants, dtype=np.int64),
-        np.array(masks, dtype=np.int64).reshape(-1, run.n_channels),
-    )
+    instants, masks, _, _ = run.follow(trigger)
+    return Schedule(np.array(instants, dtype=np.int64), np.array(masks).reshape(-1, run.n_channels))
