@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import re
 
+import numpy as np
 import pytest
 
 pytest.importorskip("rliable")
@@ -57,6 +58,32 @@ def test_rows_read_the_records_they_name() -> None:
     assert rows["always"].sets["test"].sent["mean"] == 50_000
     learned = rows[leaderboard.LEARNED]
     assert learned.sets["test"] is not None and learned.sets["test"].episodes == 5 * 64
+
+
+@pytest.mark.parametrize("board", leaderboard.BOARDS, ids=lambda board: board.name)
+def test_the_clairvoyant_row_reads_its_schedules(board) -> None:
+    """The clairvoyant row: the fewest-transmission schedules' means over the scenarios its
+    record judged, its ratios in words, no paper-scenario cell, never in the across-id
+    summary (it is not a trigger)."""
+    rows = {row.trigger: row for row in leaderboard.board_rows(leaderboard.RECORDS, board)}
+    row = rows[leaderboard.ORACLE]
+    oracle = json.loads(
+        (leaderboard.RECORDS / board.oracle / "oracle.json").read_text(encoding="utf-8")
+    )
+    test = row.sets["test"]
+    assert test is not None and row.sets["paper"] is None
+    assert test.episodes == len(oracle["per_scenario"]) == 16
+    fewest = [scenario["fewest_transmissions"] for scenario in oracle["per_scenario"]]
+    assert test.sent["mean"] == pytest.approx(np.mean([s["transmissions"] for s in fewest]))
+    assert test.cost["mean"] == pytest.approx(np.mean([s["mean_cost"] for s in fewest]))
+    for scenario in oracle["per_scenario"]:  # never more cost than the trigger it matched
+        assert scenario["fewest_transmissions"]["mean_cost"] <= (
+            scenario["trigger"]["mean_cost"] * (1 + 1e-12)
+        )
+        assert scenario["fewest_transmissions"]["transmissions"] <= (
+            scenario["trigger"]["transmissions"]
+        )
+    assert "learned ÷ clairvoyant" in row.what and test.cost_values is None
 
 
 @pytest.mark.parametrize("board", leaderboard.BOARDS, ids=lambda board: board.name)

@@ -270,26 +270,21 @@ def test_an_oracle_sweep_runs_its_scenarios_and_is_judged(tmp_path) -> None:
     summary = judge(records)
     ratio = summary["learned_over_clairvoyant"]["transmissions_at_equal_cost"]
     assert ratio["n"] == 2 and ratio["iqm"] >= 1.0
-    with pytest.raises(ValueError, match="sweep key 'kind' must be 'front' with learner 'oracle'"):
-        sweep_config_from_dict(
-            {
-                "base": str(base),
-                "results_dir": str(tmp_path / "s"),
-                "kind": "search",
-                "learner": "oracle",
-                "grid": {"scenario": [0]},
-            }
-        )
-    with pytest.raises(ValueError, match="unknown oracle key 'seed'"):
-        sweep_config_from_dict(
-            {
-                "base": str(base),
-                "results_dir": str(tmp_path / "s"),
-                "kind": "front",
-                "learner": "oracle",
-                "grid": {"seed": [0]},
-            }
-        )
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"kind": "search"}, "sweep key 'kind' must be 'front' with learner 'oracle'"),
+        ({"grid": {"seed": [0]}}, "unknown oracle key 'seed'"),
+    ],
+)
+def test_an_oracle_sweep_config_is_checked(tmp_path, change: dict, message: str) -> None:
+    base = tmp_path / "oracle.yaml"
+    base.write_text(yaml.safe_dump({"env_id": ENV_ID, "trigger": TRIGGER, "scenario": 0}))
+    raw = {"base": str(base), "results_dir": str(tmp_path / "s"), "kind": "front"}
+    with pytest.raises(ValueError, match=message):
+        sweep_config_from_dict({**raw, "learner": "oracle", "grid": {"scenario": [0]}, **change})
 
 
 def test_the_judgement_pairs_scenarios_by_seed() -> None:

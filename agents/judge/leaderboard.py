@@ -19,7 +19,11 @@ that makes it:
 * **per-instant PPO** (``<EnvName>_ppo/``) and **self-triggered PPO** (trained from scratch,
   where such a run was judged);
 * **learned trigger (ES)** — the searches of ``configs/search/<problem>.yaml``
-  (:attr:`Board.learned`).
+  (:attr:`Board.learned`);
+* **clairvoyant schedule** — not a trigger: the fewest transmissions at no more than the
+  learned trigger's cost, found with each test scenario known in advance
+  (``<EnvName>_oracle/``, :mod:`agents.judge.oracle`; its own scenarios, which the row
+  names).
 
 The figures draw the paper's threshold sweep, the periodic sweep and the hand menu's front from
 ``<EnvName>_learned_front/pareto.json`` (:attr:`Board.curves`) beside the rows.
@@ -96,6 +100,13 @@ class Board:
         """Folder of the best hand point's ``results.json`` (``models/<id>_hand.json`` judged
         by ``agents.results``: the paper's rule and the clock at the hand point's rate too)."""
         return f"{self.name}_hand"
+
+    @property
+    def oracle(self) -> str:
+        """Folder of the clairvoyant schedules' ``oracle.json`` (``agents.judge.oracle``): the
+        central id's for paper 001's PettingZoo id, whose loop and learned decisions are the
+        same."""
+        return f"{self.name.replace('ClusterContainment-', 'ClusterContainmentCentral-')}_oracle"
 
     @property
     def curves(self) -> str:
@@ -334,7 +345,40 @@ def board_rows(records: Path, board: Board) -> list[Row]:
             f"the rule's parametric family searched with CMA-ES ({len(learned['models'])} "
             "search seeds, the penalty chosen on validation)",
         ),
+        _oracle_row(records, board),
     ]
+
+
+def _oracle_row(records: Path, board: Board) -> Row:
+    """The clairvoyant schedules' row: their test scenarios' mean transmissions and cost at
+    no more than the learned trigger's cost, and learned ÷ clairvoyant (paired IQMs)."""
+    path = records / board.oracle / "oracle.json"
+    if not path.is_file():
+        return Row(ORACLE, "not searched yet", "—", dict.fromkeys(SETS))
+    oracle = _load(path)
+    fewest, trigger = oracle["means"]["fewest_transmissions"], oracle["means"]["trigger"]
+    ratios = oracle["learned_over_clairvoyant"]
+    sent, cost = ratios["transmissions_at_equal_cost"], ratios["cost_at_equal_transmissions"]
+    n = sent["n"]
+    cost_text = (
+        f"cost at its count ×{_ratio_cell(cost, 'iqm')}"
+        if cost["iqm"] is not None
+        else "cost at its count: both 0"
+    )
+    what = (
+        f"fewest transmissions at no more than the learned trigger's cost, each of the first "
+        f"{n} test scenarios known in advance (there the learned trigger: "
+        f"{_number(trigger['mean_cost']['mean'])} / {_number(trigger['transmissions']['mean'])});"
+        f" learned ÷ clairvoyant (IQM): transmissions ×{_ratio_cell(sent, 'iqm')}, {cost_text}"
+    )
+    measure = Measure(fewest["mean_cost"], fewest["transmissions"], 0, n)
+    return Row(
+        ORACLE,
+        what,
+        f"`{board.oracle}/`",
+        {"test": measure, "paper": None},
+        " && ".join(oracle["commands"]),
+    )
 
 
 HAND = "best hand-designed rule"
@@ -342,6 +386,9 @@ HAND = "best hand-designed rule"
 
 LEARNED = "learned trigger (ES)"
 """The row of the searched family point."""
+
+ORACLE = "clairvoyant schedule (knows the scenario; not a trigger)"
+"""The row of the clairvoyant schedules (:mod:`agents.oracle`)."""
 
 
 def _number(value: float) -> str:
@@ -459,6 +506,7 @@ ROW_STYLES = {
     "per-instant PPO": {"marker": "^", "color": "C4", "markersize": 10},
     "self-triggered PPO": {"marker": "v", "color": "C5", "markersize": 10},
     LEARNED: {"marker": "D", "color": "C2", "markersize": 10},
+    ORACLE: {"marker": "P", "color": "k", "markersize": 11},
 }
 """Each row's marker in the figures."""
 
@@ -611,10 +659,14 @@ def figure(board: Board, rows: list[Row], sweeps: dict[str, Any], path: Path) ->
         axes.set_title(title, fontsize=10)
     panels[0].set_ylabel("mean cost per step (lower is better)")
     handles, labels = panels[0].get_legend_handles_labels()
-    for trigger in [row.trigger for row in rows if any(row.sets.values())]:
-        style = ROW_STYLES[trigger]
+    for row in [row for row in rows if any(row.sets.values())]:
+        style = ROW_STYLES[row.trigger]
         handles.append(plt.Line2D([], [], linestyle="", **style))
-        labels.append(trigger)
+        test = row.sets["test"]
+        only = row.trigger == ORACLE and test is not None
+        labels.append(
+            f"{row.trigger}, first {test.episodes} test scenarios" if only else row.trigger
+        )
     handles.append(plt.Line2D([], [], marker="x", linestyle="", color="k", markersize=9))
     labels.append("failures in some episodes")
     fig.legend(handles, labels, loc="lower center", ncol=3, frameon=False, fontsize=9)

@@ -14,7 +14,10 @@ scenario, ``oracle.json``) and writes to ``--out``:
   of each schedule's transmissions and mean cost
   (:func:`~etsc_envs.evaluation.statistics.summarize`);
 * ``schedules.npz`` — every schedule's instants and channel masks
-  (``<seed>_<objective>_instants``, ``<seed>_<objective>_masks``), for plots and checks.
+  (``<seed>_<objective>_instants``, ``<seed>_<objective>_masks``), for plots and checks;
+
+and ``oracle.json`` names the commands that made it (the sweep's, read from its summary, and
+this one).
 
 A found schedule exists, so each ratio is a lower bound of the learned trigger's true
 distance to the limit on those scenarios.
@@ -30,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.sweep.results import ORACLE_FILE, read_sweep
+from agents.sweep.results import ORACLE_FILE, read_summary, read_sweep
 from etsc_envs.core.files import atomic_write_text, require_writable_folder
 from etsc_envs.evaluation.statistics import paired_ratio, summarize
 
@@ -141,6 +144,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {error}", file=sys.stderr)
         return 2
     summary = judge(records)
+    sweep = read_summary(args.sweep_dir).get("sweep")
+    summary["commands"] = [
+        *([f"python -m agents.sweep --config {sweep} --processes 2 --resume"] if sweep else []),
+        f"python -m agents.judge.oracle {args.sweep_dir} --out {args.out}",
+    ]
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "oracle.json", json.dumps(summary, indent=1) + "\n")
     np.savez_compressed(out / "schedules.npz", **schedule_arrays(records))
