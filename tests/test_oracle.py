@@ -195,6 +195,18 @@ def test_the_windowed_search_keeps_its_constraints_too() -> None:
         assert found[objective]["cost"] <= found["trigger"]["cost"]
 
 
+def test_a_clock_that_fails_is_no_start() -> None:
+    """Paper 003's clock at the learned trigger's count of bursts leaves the shell: the
+    least-cost search then starts from the trigger alone."""
+    run = ScheduleRun(
+        "etsc/AsteroidOrbitKeeping-v0", scenario_set("test", 1), scenario_set("test", 1).seeds[0]
+    )
+    trigger = LearnedTrigger.load("models/AsteroidOrbitKeeping-v0_learned.json")
+    found = clairvoyant(run, trigger.policy_for(run.env), budget_steps=run.n_steps, tail=None)
+    assert found["least_cost"]["starts"]["clock"] is None
+    assert found["least_cost"]["transmissions"] <= found["trigger"]["transmissions"]
+
+
 def test_every_start_is_recorded_with_its_curve(found: dict) -> None:
     starts = found["least_cost"]["starts"]
     assert set(starts) == {"trigger", "clock"}

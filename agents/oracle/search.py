@@ -338,7 +338,8 @@ def _clock_fewest(run: ScheduleRun, target: float) -> Outcome | None:
 
 
 def _clock_least_cost(run: ScheduleRun, transmissions: int) -> Outcome:
-    """The clock with the shortest period that sends at most ``transmissions``."""
+    """The clock with the shortest period that sends at most ``transmissions`` (its run may
+    fail: then it is no start)."""
     per_channel = max(transmissions // run.n_channels, 1)
     period = -(-run.n_steps // per_channel)
     return run.outcome(Schedule.clock(run.n_steps, run.n_channels, period))
@@ -393,7 +394,7 @@ def clairvoyant(
         for start_name in ("trigger", "clock"):
             begin = run.steps
             start = trigger if start_name == "trigger" else clock()
-            if start is None:
+            if start is None or start.failed:  # no clock meets the objective's bound
                 starts[start_name] = None
                 continue
             log = SearchLog()
