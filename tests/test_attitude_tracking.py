@@ -602,3 +602,32 @@ def test_rate_bound_above_the_rate_transient_does_not_terminate():
             break
     assert peak < 0.8
     assert not terminated, info.get("failure")
+
+
+def test_plant_step_evaluates_the_half_step_terms_once_bit_for_bit():
+    """The RK4 step of eq. (1)-(2) computes ω_d, J and d at t + h/2 once for its two middle
+    stages: it equals, bit for bit, the classical RK4 that computes every stage's terms at its
+    own time (so the shared evaluation changes no record)."""
+    from etsc_envs.attitude_tracking.closed_loop import episode_model, integrate_plant
+    from etsc_envs.attitude_tracking.dynamics import plant_derivative, plant_time_terms
+
+    env = make(randomize=True)
+    env.reset(seed=3)
+    loop = env.unwrapped
+    model = episode_model(loop.state, loop.constants)
+    rng = np.random.default_rng(0)
+    h = loop.sampling_period_s
+    for _ in range(20):
+        t = float(rng.uniform(0.0, 50.0))
+        y = np.concatenate([rng.normal(size=4), rng.normal(scale=0.1, size=3), rng.normal(size=4)])
+        args = (rng.normal(size=3), model)
+
+        def k(time_s: float, stage: np.ndarray) -> np.ndarray:
+            return plant_derivative(plant_time_terms(time_s, args), stage, args)  # noqa: B023
+
+        k1 = k(t, y)
+        k2 = k(t + 0.5 * h, y + 0.5 * h * k1)
+        k3 = k(t + 0.5 * h, y + 0.5 * h * k2)
+        k4 = k(t + h, y + h * k3)
+        expected = y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        assert_array_equal(integrate_plant(t, y, h, args), expected)

@@ -196,3 +196,16 @@ def test_process_and_ray_evaluators_score_alike(tmp_path: Path) -> None:
         logs.append(records)
     assert logs[0] == logs[1]
     assert logs[0][0]["transmissions"][0] > 0
+
+
+def test_search_benchmark_counts_every_env_step_it_times() -> None:
+    """``agents.bench.search`` divides the search's recorded env steps, training episodes of
+    every candidate and the validation of the mean alike, by the times it measured."""
+    from agents.bench.search import time_search
+
+    config = _config(generations=1, population=2, scenarios=3, horizon_s=0.2, validation_size=2)
+    steps, cpu, wall = time_search(config)
+    training = 2 * 3 * 200  # 0.2 s at 1 ms
+    validation = 2 * 50_000  # the paper's 50 s at 1 ms
+    assert steps == training + validation
+    assert cpu > 0.0 and wall > 0.0

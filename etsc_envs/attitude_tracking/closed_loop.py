@@ -23,6 +23,7 @@ from etsc_envs.attitude_tracking.controller import (
 from etsc_envs.attitude_tracking.dynamics import (
     PlantModel,
     plant_derivative,
+    plant_time_terms,
     tracking_error,
 )
 from etsc_envs.core import vec3
@@ -52,7 +53,7 @@ LoopConstants = namedtuple("LoopConstants", ["model", "gains", "max_rate"])
 """What every episode shares: the plant model (its phases are taken from the state row), the
 observer and controller gains, and the divergence bound on |ω| and |ω_e| (rad/s)."""
 
-integrate_plant = make_rk4_step(plant_derivative)
+integrate_plant = make_rk4_step(plant_derivative, plant_time_terms)
 
 
 @jit

@@ -85,27 +85,44 @@ def desired_rate_derivative(t: float, model: PlantModel) -> vec3.Vec3:
 
 
 @jit
-def rate_derivative(t: float, omega, torque, model: PlantModel) -> vec3.Vec3:
-    """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, with J = J(t)."""
-    inertia_now = inertia(t, model)
+def rate_derivative_given(inertia_now: np.ndarray, disturbance_now, omega, torque) -> vec3.Vec3:
+    """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, for the inertia J and disturbance d of one
+    instant."""
     gyroscopic = vec3.cross(omega, vec3.matvec(inertia_now, omega))
     return vec3.solve(
-        inertia_now, vec3.add(vec3.add(vec3.negate(gyroscopic), torque), disturbance(t, model))
+        inertia_now, vec3.add(vec3.add(vec3.negate(gyroscopic), torque), disturbance_now)
     )
 
 
 @jit
-def plant_derivative(t: float, y: np.ndarray, args) -> np.ndarray:
-    """ẏ for ``y = [q, ω, q_d]``: eq. (1) with the held torque ``args[0]``, and eq. (2)."""
-    torque, model = args
+def rate_derivative(t: float, omega, torque, model: PlantModel) -> vec3.Vec3:
+    """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, with J = J(t) and d = d(t)."""
+    return rate_derivative_given(inertia(t, model), disturbance(t, model), omega, torque)
+
+
+@jit
+def plant_time_terms(t: float, args):
+    """What :func:`plant_derivative` needs of the time t: ``(ω_d(t), J(t), d(t))`` (eqs. 53-55
+    and section 4), for the plant ``args[1]``. RK4 evaluates them once for its two stages at
+    t + h/2 (:func:`~etsc_envs.core.integration.make_rk4_step`)."""
+    model = args[1]
+    return desired_rate(t, model), inertia(t, model), disturbance(t, model)
+
+
+@jit
+def plant_derivative(time_terms, y: np.ndarray, args) -> np.ndarray:
+    """ẏ for ``y = [q, ω, q_d]``: eq. (1) with the held torque ``args[0]``, and eq. (2), with
+    the time-dependent terms ``time_terms`` of :func:`plant_time_terms`."""
+    torque = args[0]
+    omega_d, inertia_now, disturbance_now = time_terms
     omega = vec3.as_vec3(y[4:7])
     attitude_rate = quat_rate(y[0:4], omega)
-    desired_attitude_rate = quat_rate(y[7:11], desired_rate(t, model))
+    desired_attitude_rate = quat_rate(y[7:11], omega_d)
     dy = np.empty(11)
     for i in range(4):
         dy[i] = attitude_rate[i]
         dy[7 + i] = desired_attitude_rate[i]
-    vec3.store(dy[4:7], rate_derivative(t, omega, torque, model))
+    vec3.store(dy[4:7], rate_derivative_given(inertia_now, disturbance_now, omega, torque))
     return dy
 
 
