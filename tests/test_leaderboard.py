@@ -80,8 +80,9 @@ def test_the_clairvoyant_row_reads_its_schedules(board) -> None:
         assert scenario["fewest_transmissions"]["mean_cost"] <= (
             scenario["trigger"]["mean_cost"] * (1 + 1e-12)
         )
-        assert scenario["fewest_transmissions"]["transmissions"] <= (
-            scenario["trigger"]["transmissions"]
+        assert (
+            scenario["fewest_transmissions"]["transmissions"]
+            <= (scenario["trigger"]["transmissions"])
         )
     assert "learned ÷ clairvoyant" in row.what and test.cost_values is None
 
