@@ -138,6 +138,50 @@ def test_deployed_policy_takes_the_training_decisions(env_id, shield):
     assert_same(actions, policy_actions(env_id, deployed(env_id, model, **kwargs)))
 
 
+def called_actions(env_id: str, policy, call, episodes: int = 2) -> list[np.ndarray]:
+    """Transmit/hold actions of ``episodes`` seeded episodes in a row of ``policy`` on the
+    plain env, each instant's action ``call(policy, obs, state, first)`` (``state``: the
+    previous call's, ``None`` at an episode's first instant; ``first``: whether it is)."""
+    env, actions = gym.make(env_id, horizon_s=HORIZON_S), []
+    for episode in range(episodes):
+        obs, _ = env.reset(seed=SEED + episode)
+        state, first, done = None, True, False
+        while not done:
+            action, state = call(policy, obs, state, first)
+            actions.append(np.asarray(action).copy())
+            obs, _, terminated, truncated, _ = env.step(action)
+            first, done = False, terminated or truncated
+    return actions
+
+
+@pytest.mark.parametrize(("env_id", "shield"), [(ATTITUDE, None), (FORMATION, 0.5)])
+def test_calls_without_state_take_the_actions_of_calls_passing_it_back(env_id, shield):
+    kwargs = {"max_exponent": 4, "shield_multiple": shield}
+    model = ScriptedModel(rule_set(env_id, max_exponent=4).action_space.n)
+    policy = deployed(env_id, model, **kwargs)
+    stateful = called_actions(env_id, policy, lambda p, o, s, _: p.predict(o, state=s))
+    stateless = called_actions(env_id, policy, lambda p, o, s, _: p.predict(o))
+    assert_same(stateless, stateful)
+    # Deciding afresh at every instant takes other actions: the state carried matters.
+    afresh = called_actions(env_id, policy, lambda p, o, s, _: p.predict(o, episode_start=[1]))
+    assert not np.array_equal(np.array(afresh), np.array(stateful))
+
+
+def test_a_call_without_state_on_an_observation_that_does_not_follow_decides_afresh():
+    hold_8 = rule_set(ATTITUDE, max_exponent=3).action("hold 8")
+    policy = deployed(ATTITUDE, ScriptedModel(0, fixed=hold_8), max_exponent=3)
+    env = gym.make(ATTITUDE, horizon_s=HORIZON_S)
+    obs, _ = env.reset(seed=SEED)
+    other = obs.copy()
+    for _ in range(3):
+        obs = env.step(policy.predict(obs)[0])[0]
+    assert policy.predict(obs)[1].tolist() == [[hold_8, 4]]  # continues the hold
+    assert policy.predict(other)[1].tolist() == [[hold_8, 1]]  # a reset's: starts one
+    assert policy.predict(obs)[1].tolist() == [[hold_8, 1]]  # not one period on: starts one
+    two_rows = np.stack([obs, obs])
+    assert policy.predict(two_rows)[1].tolist() == [[hold_8, 1]] * 2  # other rows: starts
+
+
 def decision_episode(env: gym.Env, model, **kwargs) -> list[tuple]:
     """Every decision's result of one seeded episode of the wrapper over ``env``."""
     wrapper = rule_wrapper(env, **kwargs)

@@ -14,6 +14,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from etsc_envs.core.multi_agent import CLOCK_NAME
 from etsc_envs.decisions.actions import DecisionSet, decision_set_path
 from etsc_envs.decisions.schedule import IntervalSchedule
 from etsc_envs.sb3_models import env_id_of, load_sb3, takes_action_masks
@@ -47,6 +48,17 @@ class SelfTriggeredPolicy:
     action, masked by the shield if the set has one (``action_masks`` is passed to a model that
     takes it, such as ``MaskablePPO``; any other model's unsafe choice is replaced).
 
+    Called without ``state`` (``action, _ = policy.predict(obs)``), the policy continues the
+    state its previous call returned, so that the calls take the same actions as calls passing
+    the state back. A row continues when the previous call had as many rows, ``episode_start``
+    does not mark it, and its observation follows that call's: every
+    ``time_since_transmission_s`` entry is one sampling period (the channel transmitted) or the
+    previous value plus one period (it held, or refused a transmission). Any other row starts
+    an interval at this instant: the first call, a reset's observation (every entry 0), an
+    observation of another env or episode. One policy called without ``state`` therefore
+    serves one sequence of observations (one env, or one batch of rows); for envs stepped
+    alternately, pass each one's ``state`` back.
+
     Args:
         model: anything with an SB3-style ``predict`` over the decision set's actions.
         decisions: the decision set.
@@ -72,6 +84,14 @@ class SelfTriggeredPolicy:
         )
         self.observation_space = observation_space
         self.action_space = action_space
+        self.sampling_period_s = float(sampling_period_s)
+        self.clock_columns = np.array(
+            [i for i, name in enumerate(observation_names) if name.startswith(CLOCK_NAME)]
+        )
+        if not len(self.clock_columns):
+            raise ValueError(f"observation_names: no {CLOCK_NAME} entry in {observation_names}")
+        self._last_state: np.ndarray | None = None
+        self._last_clocks: np.ndarray | None = None
 
     @classmethod
     def for_env(cls, model: Any, decisions: DecisionSet, env: Any) -> SelfTriggeredPolicy:
@@ -95,20 +115,38 @@ class SelfTriggeredPolicy:
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Transmit decision(s) for ``observation``, and the rows' interval state."""
+        """Transmit decision(s) for ``observation``, and the rows' interval state (without
+        ``state``, the previous call's where the rows continue it: see the class)."""
         obs, single = batched_observations(observation, self.observation_space)
+        clocks = obs[:, self.clock_columns].astype(float)
+        starting = np.zeros(len(obs), dtype=bool)
         if state is None:
-            state, deciding = self.schedule.start(np.zeros(len(obs))), np.ones(len(obs), bool)
+            state, starting = self._remembered_state(clocks)
         else:
             state = np.array(state, dtype=np.int64)
-            deciding = self.schedule.interval_over(obs, state)
         if episode_start is not None:
-            deciding |= np.asarray(episode_start, dtype=bool).reshape(-1)
+            starting |= np.asarray(episode_start, dtype=bool).reshape(-1)
+        deciding = starting | self.schedule.interval_over(obs, state)
         if deciding.any():
             state[deciding] = self.schedule.start(self.choose(obs[deciding], deterministic))
         decision, state = self.schedule.transmit(obs, state)
+        self._last_state, self._last_clocks = state, clocks
         action = decision.astype(np.int64)
         return (action[0] if single else action), state
+
+    def _remembered_state(self, clocks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The state of the previous call for rows whose clocks ``clocks`` follow its (see the
+        class), a fresh one elsewhere, and which rows start afresh."""
+        last_state, last_clocks = self._last_state, self._last_clocks
+        if last_state is None or last_clocks is None or len(last_state) != len(clocks):
+            return self.schedule.start(np.zeros(len(clocks))), np.ones(len(clocks), dtype=bool)
+        period = self.sampling_period_s
+        transmitted = np.abs(clocks - period) <= period / 2
+        held = np.abs(clocks - (last_clocks + period)) <= period / 2
+        starting = ~(transmitted | held).all(axis=1)
+        state = last_state.copy()
+        state[starting] = self.schedule.start(np.zeros(int(starting.sum())))
+        return state, starting
 
 
 def sb3_policy(
