@@ -143,7 +143,7 @@ class SelfTriggeredPolicy:
         period = self.sampling_period_s
         transmitted = np.abs(clocks - period) <= period / 2
         held = np.abs(clocks - (last_clocks + period)) <= period / 2
-        starting = ~(transmitted | held).all(axis=1)
+        starting = np.asarray(~(transmitted | held).all(axis=1), dtype=bool)
         state = last_state.copy()
         state[starting] = self.schedule.start(np.zeros(int(starting.sum())))
         return state, starting
