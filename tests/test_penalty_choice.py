@@ -73,3 +73,57 @@ def test_an_unfinished_trial_is_refused(tmp_path: Path, capsys) -> None:
     with pytest.raises(SystemExit):
         main([str(front)])
     assert "is incomplete; finish the sweep first" in capsys.readouterr().err
+
+
+def _training_front(tmp_path: Path, runs: dict[tuple[float, int], list[tuple]]) -> Path:
+    """A front of training runs whose evaluations at (penalty, seed) recorded the
+    (return, transmissions, mean cost) given, beside the paper rule's validation."""
+    trials = []
+    for (penalty, seed), evaluations in runs.items():
+        name = f"transmission_penalty={penalty:g},seed={seed}"
+        folder = tmp_path / "trials" / name
+        folder.mkdir(parents=True)
+        paper = {"transmissions": START[0], "mean_cost": START[1], "return": -1.0}
+        entries = [
+            {"learned": {"return": r, "transmissions": sent, "mean_cost": cost}, "paper": paper}
+            for r, sent, cost in evaluations
+        ]
+        (folder / "evaluations.json").write_text(json.dumps(entries))
+        values = {"env_kwargs.transmission_penalty": penalty, "seed": seed}
+        trials.append(SweepTrial(name, values, "finished", None, folder, None))
+    write_summary(tmp_path, {"env_id": "etsc/AttitudeTracking-v0", "kind": "front"}, trials)
+    return tmp_path
+
+
+def test_a_training_front_is_judged_at_its_best_validation_checkpoints(tmp_path: Path) -> None:
+    """Each run's point is its best-return evaluation (the checkpoint it keeps), not its last;
+    the reference is the paper rule every run validated."""
+    front = _training_front(
+        tmp_path,
+        {
+            (100.0, 0): [(-5.0, 100.0, 0.009), (-2.0, 140.0, 0.0099), (-3.0, 90.0, 0.02)],
+            (100.0, 1): [(-1.0, 146.0, 0.0097)],
+            (300.0, 0): [(-4.0, 120.0, 0.011), (-9.0, 80.0, 0.0090)],
+            (300.0, 1): [(-1.0, 110.0, 0.012)],
+        },
+    )
+    choice = choose_penalty(front)
+    assert choice["reference"] == "paper rule"
+    assert choice["penalties"][0]["learned"] == {
+        "transmissions": 143.0,
+        "mean_cost": pytest.approx(0.0098),
+    }
+    assert [row["contains_start"] for row in choice["penalties"]] == [True, False]
+    assert choice["chosen"] == 100.0
+    assert choice["penalties"][1]["larger_ratio"] == pytest.approx(1.15)
+
+
+def test_where_no_penalty_contains_the_closest_is_named(tmp_path: Path, capsys) -> None:
+    front = _training_front(
+        tmp_path,
+        {(10.0, 0): [(-1.0, 300.0, 0.009)], (100.0, 0): [(-1.0, 160.0, 0.0101)]},
+    )
+    choice = choose_penalty(front)
+    assert choice["chosen"] is None and choice["closest"] == 100.0
+    assert main([str(front)]) == 0
+    assert "no penalty contains the paper rule (closest: 100)" in capsys.readouterr().out

@@ -12,8 +12,16 @@ pytest.importorskip("stable_baselines3")
 
 from stable_baselines3 import PPO
 
-from agents.judge.results import clock_verdict, equal_rate_period, main, markdown, verdict_text
+from agents.judge.results import (
+    clock_verdict,
+    equal_rate_period,
+    main,
+    markdown,
+    model_kind,
+    verdict_text,
+)
 from agents.train.vector_adapter import make_sb3_vec_env
+from etsc_envs.decisions import DecisionSet, Hold
 from etsc_envs.evaluation.statistics import paired_ratio
 
 ENV_ID = "etsc/AttitudeTracking-v0"
@@ -58,9 +66,22 @@ def test_results_judges_models_on_the_paper_scenario_and_the_test_set(tmp_path: 
     assert len(method["vs_paper"]["mean_cost"]["per_run"]) == 3
     paper = result["sets"]["paper"]
     assert paper["scenarios"]["size"] == 1 and paper["paper"]["env_args"]["randomize"] is False
+    assert [row["kind"] for row in test["models"]] == ["PPO"] * 3
     text = markdown(result)
     assert "**Test set (4 scenarios)**" in text and "| paper |" in text
+    assert "| PPO #3 |" in text and "learned #" not in text
     assert "method over 3 seeds" in text
+
+
+def test_a_model_is_named_by_what_it_is(tmp_path: Path) -> None:
+    """A PPO model is a PPO model: only a search's point is a "learned trigger"."""
+    models = Path(__file__).resolve().parents[1] / "models"
+    assert model_kind(str(models / "AttitudeTracking-v0_learned.json")) == "learned trigger"
+    assert model_kind(f"learned:{models / 'AttitudeTracking-v0_hand.json'}") == "hand point"
+    model = tiny_model(tmp_path / "model.zip", 0)
+    assert model_kind(str(model)) == "PPO"
+    DecisionSet(ENV_ID, [Hold(1), Hold(2)]).save(model)
+    assert model_kind(f"sb3:{model}") == "self-triggered PPO"
 
 
 def test_one_model_makes_no_claim(tmp_path: Path) -> None:

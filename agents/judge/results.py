@@ -28,6 +28,9 @@ With three or more models the method's verdicts use the IQM over seeds × scenar
 rliable's stratified bootstrap interval, and the range of the per-seed IQMs; with fewer, the
 page states that there is no claim (a claim stands on at least :data:`MIN_CLAIM_SEEDS` seeds).
 
+The tables name each model by what it is (:func:`model_kind`: ``PPO #1``, ``self-triggered
+MaskablePPO #2``, ``learned trigger #1``, ``hand point #1``), and so does its row's ``kind``.
+
 Writes ``results.json`` (every episode record included) into ``DIR`` (default
 ``results/<env name>``) and prints the tables as Markdown. A ``DIR`` whose ``results.json``
 judged other models (or another id) is refused before any work: each model, or set of seeds,
@@ -53,6 +56,7 @@ from baselines.evaluate import evaluate
 from etsc_envs.cli import positive_integer
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.core.json_files import read_json_file, require_mapping
+from etsc_envs.decisions import decision_set_path
 from etsc_envs.evaluation import verdict
 from etsc_envs.evaluation.arguments import (
     limit_torch_threads,
@@ -65,6 +69,8 @@ from etsc_envs.evaluation.statistics import paired_ratio, seeds_ratio
 from etsc_envs.evaluation.verdict import Verdict, ratio_axis
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import DEFAULT_SET_SIZE, PROTOCOL_VERSION, SCENARIO_SET_NAMES
+from etsc_envs.sb3_models import infer_sb3_algorithm
+from etsc_envs.triggers.family import LearnedTrigger
 
 COST_RATIO_MAX = 1.05
 """The learned trigger may be this much less accurate than the paper's (cost ratio bound)."""
@@ -123,6 +129,19 @@ def clock_verdict(cost_ratio: dict[str, Any], failures: int, clock_failures: int
     return verdict.compare(failures, clock_failures, {"cost ratio": ratio_axis(cost_ratio)})
 
 
+def model_kind(model: str) -> str:
+    """What a ``--model`` is, as the tables name it: a family point's file is the ``hand
+    point`` (its ``hand`` record) or a ``learned trigger`` (a search's); an SB3 zip is its
+    algorithm (``PPO``, ``MaskablePPO``, ``DQN``), ``self-triggered`` where a decision set sits
+    beside it. A name, not a verdict: "learned trigger" is kept for what an optimiser found in a
+    rule's family."""
+    kind, _, path = model_spec(model).partition(":")
+    if kind == "learned":
+        return "hand point" if LearnedTrigger.load(path).hand else "learned trigger"
+    algorithm = infer_sb3_algorithm(path).__name__
+    return f"self-triggered {algorithm}" if decision_set_path(path).is_file() else algorithm
+
+
 def _compare_set(
     env_id: str,
     models: list[str],
@@ -166,6 +185,7 @@ def _compare_set(
         learned_rows.append(
             {
                 "model": model,
+                "kind": model_kind(model),
                 "learned": learned,
                 "periodic_every": every,
                 "periodic": periodic,
@@ -318,15 +338,16 @@ def markdown(result: dict[str, Any]) -> str:
             "|---" * (5 + len(keys)) + "|",
             _policy_row("paper", compared["paper"], keys),
         ]
-        for index, row in enumerate(compared["models"], start=1):
-            lines.append(_policy_row(f"learned #{index}", row["learned"], keys))
+        names = [f"{row['kind']} #{index}" for index, row in enumerate(compared["models"], 1)]
+        for name, row in zip(names, compared["models"], strict=True):
+            lines.append(_policy_row(name, row["learned"], keys))
             lines.append(
                 _policy_row(f"periodic every {row['periodic_every']}", row["periodic"], keys)
             )
         lines.append("")
-        for index, row in enumerate(compared["models"], start=1):
+        for name, row in zip(names, compared["models"], strict=True):
             lines.append(
-                f"- learned #{index} (`{row['model']}`): cost ×paper "
+                f"- {name} (`{row['model']}`): cost ×paper "
                 f"{_ratio_text(row['vs_paper']['mean_cost'])}, transmissions ×paper "
                 f"{_ratio_text(row['vs_paper']['transmissions'])}, cost ×periodic "
                 f"{_ratio_text(row['vs_periodic']['mean_cost'])} (IQM of per-scenario ratios); "
