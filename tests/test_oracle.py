@@ -12,6 +12,7 @@ import yaml
 
 import etsc_envs
 from agents.judge.oracle import judge, read_runs
+from agents.judge.oracle import main as judge_main
 from agents.oracle.__main__ import main as oracle_main
 from agents.oracle.run import oracle_config_from_dict, run_oracle
 from agents.oracle.schedule import Schedule, ScheduleRun, trigger_schedule
@@ -243,6 +244,15 @@ def test_the_command_refuses_bad_input_in_one_line(tmp_path, capsys) -> None:
         capsys.readouterr().err.strip()
         == "error: --tail must be an integer >= 0 or none, got 'far'"
     )
+    for change, line in [
+        (["--scenario", "-1"], "error: --scenario must be an index >= 0 of the set, got -1"),
+        (["--budget-episodes", "0"], "error: --budget-episodes must be a number > 0, got 0.0"),
+        (["--scenarios", "paper"], "error: --scenarios must be one of"),
+    ]:
+        assert oracle_main([*base, *change]) == 2
+        assert capsys.readouterr().err.strip().startswith(line)
+    assert oracle_main(["etsc/Nope-v0", *base[1:]]) == 2
+    assert capsys.readouterr().err.startswith("error: ENV_ID must be a single-agent id")
     (tmp_path / "oracle.json").write_text("{}")
     assert oracle_main(base) == 2
     assert "already holds a record" in capsys.readouterr().err
@@ -259,7 +269,7 @@ def test_a_run_writes_its_record(tmp_path) -> None:
 
 
 # ------------------------------------------------------------------------- sweep and judge
-def test_an_oracle_sweep_runs_its_scenarios_and_is_judged(tmp_path) -> None:
+def test_an_oracle_sweep_runs_its_scenarios_and_is_judged(tmp_path, capsys) -> None:
     base = tmp_path / "oracle.yaml"
     base.write_text(
         yaml.safe_dump(
@@ -282,6 +292,16 @@ def test_an_oracle_sweep_runs_its_scenarios_and_is_judged(tmp_path) -> None:
     summary = judge(records)
     ratio = summary["learned_over_clairvoyant"]["transmissions_at_equal_cost"]
     assert ratio["n"] == 2 and ratio["iqm"] >= 1.0
+    out = tmp_path / "judged"
+    assert judge_main([str(tmp_path / "sweep"), "--out", str(out)]) == 0
+    assert judge_main([str(tmp_path / "sweep"), "--out", str(out)]) == 0  # again, in place
+    held = json.loads((out / "oracle.json").read_text())
+    (out / "oracle.json").write_text(json.dumps({**held, "seeds": held["seeds"][:1]}))
+    assert judge_main([str(tmp_path / "sweep"), "--out", str(out)]) == 2
+    assert "holds the clairvoyant schedules of" in capsys.readouterr().err
+    assert json.loads((out / "oracle.json").read_text())["seeds"] == held["seeds"][:1]
+    assert judge_main([str(tmp_path / "nowhere"), "--out", str(out)]) == 2
+    assert capsys.readouterr().err.startswith("error: SWEEP_DIR: ")
 
 
 @pytest.mark.parametrize(

@@ -35,6 +35,7 @@ import numpy as np
 
 from agents.sweep.results import ORACLE_FILE, read_summary, read_sweep
 from etsc_envs.core.files import atomic_write_text, require_writable_folder
+from etsc_envs.core.json_files import read_json_file, require_mapping
 from etsc_envs.evaluation.statistics import paired_ratio, summarize
 
 OBJECTIVES = ("fewest_transmissions", "least_cost")
@@ -130,6 +131,24 @@ def schedule_arrays(records: list[dict[str, Any]]) -> dict[str, np.ndarray]:
     return arrays
 
 
+def require_own_record(out: Path, records: list[dict[str, Any]]) -> None:
+    """``ValueError`` before any work when ``out`` holds the ``oracle.json`` of another id,
+    trigger or set of scenarios: a record is judged again in place, never replaced by
+    another's."""
+    path = out / "oracle.json"
+    if not path.exists():
+        return
+    held = require_mapping(read_json_file(path, f"--out {path}"), "")
+    settings = records[0]["settings"]
+    mine = (settings["env_id"], settings["trigger"], [record["seed"] for record in records])
+    if (held.get("env_id"), held.get("trigger"), held.get("seeds")) != mine:
+        raise ValueError(
+            f"--out {out} holds the clairvoyant schedules of {held.get('trigger')!r} on "
+            f"{held.get('env_id')!r}, {len(held.get('seeds') or [])} scenarios; give this "
+            f"sweep its own --out"
+        )
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m agents.judge.oracle", description=__doc__.split("\n\n")[0]
@@ -140,8 +159,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         out = require_writable_folder(args.out, "--out")
         records = read_runs(args.sweep_dir)
+        require_own_record(out, records)
     except ValueError as error:
-        print(f"error: {error}", file=sys.stderr)
+        print(f"error: {str(error).replace('--sweep', 'SWEEP_DIR')}", file=sys.stderr)
         return 2
     summary = judge(records)
     sweep = read_summary(args.sweep_dir).get("sweep")

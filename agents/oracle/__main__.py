@@ -12,8 +12,27 @@ import argparse
 import sys
 from pathlib import Path
 
-from agents.oracle.run import ORACLE_FILE, oracle_config_from_dict, run_oracle
+from agents.oracle.run import ORACLE_FILE, OracleConfig, oracle_config_from_dict, run_oracle
 from etsc_envs.core.files import require_writable_folder
+
+ARGUMENTS = {
+    "env_id": "ENV_ID",
+    "trigger": "--trigger",
+    "scenarios": "--scenarios",
+    "scenario": "--scenario",
+    "budget_episodes": "--budget-episodes",
+    "tail": "--tail",
+}
+"""The command-line argument of each setting (:class:`~agents.oracle.run.OracleConfig`)."""
+
+
+def argument_error(error: ValueError) -> str:
+    """A setting's one-line error as the command line says it: naming the argument given
+    (``--scenario``), not the config key (``key 'scenario'``)."""
+    message = str(error)
+    for key, argument in ARGUMENTS.items():
+        message = message.replace(f"key '{key}'", argument)
+    return message
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -38,35 +57,41 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        if args.tail == "none":
-            tail = None
-        elif args.tail.isdigit():
-            tail = int(args.tail)
-        else:
-            raise ValueError(f"--tail must be an integer >= 0 or none, got {args.tail!r}")
-        config = oracle_config_from_dict(
-            {
-                "env_id": args.env_id.removeprefix("etsc_envs:"),
-                "trigger": args.trigger.removeprefix("learned:"),
-                "scenario": args.scenario,
-                "scenarios": args.scenarios,
-                "budget_episodes": args.budget_episodes,
-                "tail": tail,
-            }
-        )
-        out = Path(args.out)
-        require_writable_folder(out, "--out")
-        if (out / ORACLE_FILE).exists() and not args.overwrite:
-            raise ValueError(f"--out {out} already holds a record; choose another or --overwrite")
+        config, out = _checked(args)
         record = run_oracle(config, out)
     except ValueError as error:
-        print(f"error: {error}", file=sys.stderr)
+        print(f"error: {argument_error(error)}", file=sys.stderr)
         return 2
     for name in ("trigger", "fewest_transmissions", "least_cost"):
         part = record[name]
         print(f"{name}: {part['transmissions']} transmissions, mean cost {part['mean_cost']:.6g}")
     print(f"wrote {out / ORACLE_FILE} ({record['wall_time_s']:.0f} s)")
     return 0
+
+
+def _checked(args: argparse.Namespace) -> tuple[OracleConfig, Path]:
+    """The run's settings and output folder, every argument checked before any work."""
+    if args.tail == "none":
+        tail = None
+    elif args.tail.isdigit():
+        tail = int(args.tail)
+    else:
+        raise ValueError(f"--tail must be an integer >= 0 or none, got {args.tail!r}")
+    config = oracle_config_from_dict(
+        {
+            "env_id": args.env_id.removeprefix("etsc_envs:"),
+            "trigger": args.trigger.removeprefix("learned:"),
+            "scenario": args.scenario,
+            "scenarios": args.scenarios,
+            "budget_episodes": args.budget_episodes,
+            "tail": tail,
+        }
+    )
+    out = Path(args.out)
+    require_writable_folder(out, "--out")
+    if (out / ORACLE_FILE).exists() and not args.overwrite:
+        raise ValueError(f"--out {out} already holds a record; choose another or --overwrite")
+    return config, out
 
 
 if __name__ == "__main__":
