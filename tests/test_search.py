@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from agents.search.cma_es import (
+    EXPONENT_RANGE,
     Evaluator,
     SearchSpace,
     config_from_dict,
@@ -132,6 +133,18 @@ def test_encoding_round_trips_and_respects_the_papers_bounds() -> None:
     assert space.decode(space.lower).floor_instants == 0.0
 
 
+def test_the_exponent_box_is_the_configs() -> None:
+    """``exponent_range`` widens p's box for one config and leaves every other search's
+    decoding as it was (the default box)."""
+    default = SearchSpace(_config(search=["exponent"]), n_steps=50_000, modulation=None)
+    assert (default.lower[0], default.upper[0]) == EXPONENT_RANGE
+    config = _config(search=["exponent"], exponent_range=[-1.0, 4.0], start={"exponent": 3.0})
+    wide = SearchSpace(config, n_steps=50_000, modulation=None)
+    assert (wide.lower[0], wide.upper[0]) == (-1.0, 4.0)
+    assert wide.decode(wide.encode(config.start)).exponent == 3.0
+    assert wide.decode([10.0]).exponent == 4.0
+
+
 def test_training_seeds_avoid_the_protocols_sets() -> None:
     config = _config(scenarios=64)
     for generation in (0, 1, 10_000):
@@ -154,6 +167,10 @@ def test_training_seeds_avoid_the_protocols_sets() -> None:
         ({"search": ["modulation"]}, "inputs"),
         ({"colour": "red"}, "unknown keys"),
         ({"start": {"factors": {"psi": 0.0}}}, "factors.psi"),
+        ({"exponent_range": [2.0, 1.0]}, r"search.exponent_range' must be \[low, high\]"),
+        ({"exponent_range": [-1.0, 9.0]}, "exponent_range"),
+        ({"exponent_range": [0.0]}, "exponent_range"),
+        ({"start": {"exponent": 3.0}}, r"start.exponent' must lie in exponent_range \[-1.0, 2.0\]"),
     ],
 )
 def test_bad_configs_are_refused_naming_the_key(changes, message) -> None:

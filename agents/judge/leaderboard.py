@@ -120,7 +120,20 @@ BOARDS = (
     Board("etsc/OrbitAttitudeTracking-v0", "000", "OrbitAttitudeTracking-v0_learned_large_budget"),
     Board("etsc/ClusterContainment-v0", "001", "ClusterContainment-v0_learned"),
     Board("etsc/ClusterContainmentCentral-v0", "001", "ClusterContainmentCentral-v0_learned"),
-    Board("etsc/AttitudeTracking-v0", "002", "AttitudeTracking-v0_learned_large_budget"),
+    Board(
+        "etsc/AttitudeTracking-v0",
+        "002",
+        "AttitudeTracking-v0_learned_large_budget",
+        "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
+        "holds or eq. (27) × f from scratch, 5 seeds at λ = 300, best-validation checkpoints "
+        "(no λ of 100, 300 contained the paper rule on validation; 300 came closest)",
+        "python -m agents.sweep --processes 2 --config "
+        "configs/sweeps/attitude_tracking_self_triggered_front.yaml && "
+        "python -m agents.judge.penalty_choice "
+        "runs/sweeps/attitude_tracking_self_triggered_front && python -m agents.results "
+        "etsc/AttitudeTracking-v0 --sweep runs/sweeps/attitude_tracking_self_triggered_front "
+        "--out docs/results/AttitudeTracking-v0_self_triggered_scratch",
+    ),
     Board(
         "etsc/AsteroidOrbitKeeping-v0",
         "003",

@@ -7,7 +7,8 @@ The algorithm, in full:
 
 1. θ (the family's point) is encoded as a vector x: log2 of each searched threshold factor,
    log2 of the floor and of the heartbeat in sampling instants (below -1: no floor; above
-   log2 of the horizon: no heartbeat), the time exponent p, and the network's weights when the
+   log2 of the horizon: no heartbeat), the time exponent p (in ``exponent_range``, default
+   [-1, 2]), and the network's weights when the
    config searches a state-dependent modulation. x starts at the config's ``start`` point
    (today's best hand rule, so the search begins where the menu ended).
 2. Each generation, CMA-ES (pycma) asks for ``population`` candidates. Every candidate is
@@ -92,6 +93,9 @@ LOG2_FACTOR_RANGE = 8.0
 """A searched factor stays within 2^±8 of 1 (or inside the paper's bound)."""
 
 EXPONENT_RANGE = (-1.0, 2.0)
+"""The time exponent p's box by default (a config's ``exponent_range`` replaces it)."""
+MAX_EXPONENT = 8.0
+"""|p| of an ``exponent_range`` stays below this: τ^8 spans 10^±8 over a decade of intervals."""
 WEIGHT_RANGE = 4.0
 STEP_SCALE = {"factors": 1.0, "floor": 1.0, "heartbeat": 1.0, "exponent": 0.25, "modulation": 0.3}
 """Initial step size of each part, relative to ``sigma`` (x is in log2 units for the first
@@ -117,6 +121,7 @@ class SearchConfig:
     inputs: tuple[str, ...] = ()
     keywords: dict[str, Any] = field(default_factory=dict)
     seed: int = 0
+    exponent_range: tuple[float, float] = EXPONENT_RANGE
 
     @property
     def family(self) -> type:
@@ -199,6 +204,12 @@ def _checked_config(raw: dict[str, Any]) -> SearchConfig:
     horizon_s = raw.get("horizon_s")
     if horizon_s is not None:
         horizon_s = require_number(horizon_s, "search.horizon_s", low=0.0, low_open=True)
+    exponent_range = _exponent_range(raw.get("exponent_range", list(EXPONENT_RANGE)))
+    if not exponent_range[0] <= start.exponent <= exponent_range[1]:
+        raise ValueError(
+            f"key 'search.start.exponent' must lie in exponent_range {list(exponent_range)}, "
+            f"got {start.exponent!r}"
+        )
     names = _observation_names(env_id, horizon_s)
     inputs = require_strings(raw.get("inputs", []), "search.inputs", names)
     if ("modulation" in search) != bool(inputs):
@@ -215,8 +226,22 @@ def _checked_config(raw: dict[str, Any]) -> SearchConfig:
         horizon_s=horizon_s,
         inputs=inputs,
         keywords=require_keywords(family, raw.get("keywords", {}), "search.keywords"),
+        exponent_range=exponent_range,
         **counts,
     )
+
+
+def _exponent_range(value: Any) -> tuple[float, float]:
+    """``[low, high]``: the box of the time exponent p, ``-MAX_EXPONENT <= low < high <=
+    MAX_EXPONENT``."""
+    bounds = require_array(value, "search.exponent_range", (2,))
+    low, high = (float(bound) for bound in bounds)
+    if not -MAX_EXPONENT <= low < high <= MAX_EXPONENT:
+        raise ValueError(
+            f"key 'search.exponent_range' must be [low, high] with -{MAX_EXPONENT:g} <= low < "
+            f"high <= {MAX_EXPONENT:g}, got {value!r}"
+        )
+    return low, high
 
 
 def _observation_names(env_id: str, horizon_s: float | None) -> tuple[str, ...]:
@@ -261,7 +286,7 @@ class SearchSpace:
         for part, low, high in (
             ("floor", -1.0, math.log2(n_steps)),
             ("heartbeat", 0.0, self.no_heartbeat),
-            ("exponent", *EXPONENT_RANGE),
+            ("exponent", *config.exponent_range),
         ):
             if part in config.search:
                 lower.append(low)
