@@ -74,6 +74,7 @@ from etsc_envs.core.validation import MAX_TRANSMISSION_PENALTY
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import require_training_seeds, scenario_set
 from etsc_envs.triggers.family import (
+    MAX_EXPONENT,
     MAX_HIDDEN,
     FamilyPoint,
     LearnedTrigger,
@@ -94,8 +95,6 @@ LOG2_FACTOR_RANGE = 8.0
 
 EXPONENT_RANGE = (-1.0, 2.0)
 """The time exponent p's box by default (a config's ``exponent_range`` replaces it)."""
-MAX_EXPONENT = 8.0
-"""|p| of an ``exponent_range`` stays below this: τ^8 spans 10^±8 over a decade of intervals."""
 WEIGHT_RANGE = 4.0
 STEP_SCALE = {"factors": 1.0, "floor": 1.0, "heartbeat": 1.0, "exponent": 0.25, "modulation": 0.3}
 """Initial step size of each part, relative to ``sigma`` (x is in log2 units for the first

@@ -73,6 +73,9 @@ FORMAT_VERSION = 1
 MAX_HIDDEN = 16
 """The widest hidden layer of the modulation network."""
 
+MAX_EXPONENT = 4.0
+"""|p| of a point stays within this: τ^4 spans 10^±4 over a decade of intervals."""
+
 MODULATION_BOUND = 3.0
 """|g| is clipped here: the network scales a threshold or bound by at most e^3 ≈ 20 either way."""
 
@@ -257,8 +260,11 @@ class FamilyPoint:
             raise ValueError("heartbeat_instants must be >= 1 (sampling instants; inf for none)")
         object.__setattr__(self, "heartbeat_instants", heartbeat)
         exponent = float(self.exponent)
-        if not math.isfinite(exponent) or abs(exponent) > 4.0:
-            raise ValueError(f"exponent must be a number in [-4, 4], got {self.exponent!r}")
+        if not math.isfinite(exponent) or abs(exponent) > MAX_EXPONENT:
+            raise ValueError(
+                f"exponent must be a number in [-{MAX_EXPONENT:g}, {MAX_EXPONENT:g}], "
+                f"got {self.exponent!r}"
+            )
         object.__setattr__(self, "exponent", exponent)
         object.__setattr__(self, "first_instant", require_bool(self.first_instant, "first_instant"))
 
@@ -300,7 +306,7 @@ class FamilyPoint:
                 infinity=True,
             ),
             exponent=require_number(
-                data.get("exponent", 0.0), f"{key}.exponent", low=-4.0, high=4.0
+                data.get("exponent", 0.0), f"{key}.exponent", low=-MAX_EXPONENT, high=MAX_EXPONENT
             ),
             first_instant=require_bool(data.get("first_instant", False), f"{key}.first_instant"),
             modulation=(
