@@ -31,6 +31,7 @@ from etsc_envs.triggers.base import (
     instants_seconds,
 )
 from etsc_envs.triggers.family import (
+    Coupling,
     FamilyPoint,
     LearnedTrigger,
     Modulation,
@@ -217,6 +218,106 @@ def test_kernel_decisions_equal_predict_and_the_python_model() -> None:
     assert batch[0]["transmissions"] == predicted
 
 
+def _coupled_trigger(env: gym.Env, point: FamilyPoint):
+    loop = env.unwrapped
+    family = family_trigger_class(InnerFormationTrigger)
+    names = loop.observation_names
+    return family(env.observation_space, env.action_space, names, point, loop.sampling_period_s)
+
+
+COUPLED = {
+    "004 norm, all channels": ("etsc/InnerFormation-v0", Coupling((1.0, 0.7, 1.3))),
+    "004 kappa 0.4, own channel": (
+        "etsc/InnerFormation-v0",
+        Coupling((1.0, 0.7, 1.3), 0.4, refresh_all=False),
+    ),
+    "000 torque and force": ("etsc/OrbitAttitudeTracking-v0", Coupling((0.8, 1.5))),
+}
+COUPLED_START = {
+    "etsc/InnerFormation-v0": {"factors": {"pi": 2.0}, "exponent": 0.5},
+    "etsc/OrbitAttitudeTracking-v0": {"factors": {"gamma1": 2.0, "gamma2": 2.0}},
+}
+
+
+def _coupled_trigger(env: gym.Env, point: FamilyPoint):
+    loop = env.unwrapped
+    family = family_trigger_class(PAPER_CLASSES[env.spec.id])
+    names = loop.observation_names
+    return family(env.observation_space, env.action_space, names, point, loop.sampling_period_s)
+
+
+@pytest.mark.parametrize("case", sorted(COUPLED))
+def test_a_coupled_point_decides_by_its_formula(case: str) -> None:
+    """A coupled point on 004's three axes and 000's two conditions: predict's decisions are
+    the module docstring's formula in NumPy (channel c's condition Σ_j (w_cj r_cj)² + κ Σ_d≠c
+    Σ_j (w_dj r_dj)² > 1 past the floor, a heartbeat or the first instant; every channel
+    where refresh_all and one sends), and the compiled loop sends what predict sends."""
+    env_id, coupling = COUPLED[case]
+    env = gym.make(env_id, horizon_s=HORIZON_S[env_id], randomize=True)
+    point = FamilyPoint(
+        floor_instants=3,
+        heartbeat_instants=300,
+        first_instant=True,
+        coupling=coupling,
+        **COUPLED_START[env_id],
+    )
+    trigger = _coupled_trigger(env, point)
+    inner = trigger.inner
+    names = env.unwrapped.observation_names
+    times = [i for i, name in enumerate(names) if name.startswith("time_since_transmission_s")]
+    period = env.unwrapped.sampling_period_s
+    weights, kappa, exponent = np.array(coupling.weights), coupling.strength, point.exponent
+    indices = np.asarray(inner.rule_indices, dtype=np.int64)
+    parameters = np.asarray(inner.rule_parameters, dtype=np.float64)
+    obs, _ = env.reset(seed=3)
+    sent, by_formula, done = 0, 0, False
+    while not done:
+        action, _ = trigger.predict(obs)
+        statistic, threshold = np.empty(weights.size), np.empty(weights.size)
+        type(inner).condition(obs, indices, parameters, statistic, threshold)
+        tau = obs[times].astype(np.float64)
+        per_condition = np.repeat(tau, weights.size // tau.size)
+        ratios = statistic * per_condition**exponent / (threshold * 0.05**exponent)
+        own = ((weights * ratios) ** 2).reshape(tau.size, -1).sum(axis=1)
+        formula = (tau >= 2.5 * period) & (own + kappa * (own.sum() - own) > 1.0)
+        clock = (tau < 0.5 * period) | (tau >= 299.5 * period)
+        expected = formula | clock
+        if coupling.refresh_all and expected.any():
+            expected[:] = True
+        assert np.atleast_1d(action).tolist() == expected.astype(int).tolist()
+        by_formula += int((formula & ~clock).any())
+        sent += int(np.sum(action))
+        obs, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    assert by_formula > 5 and sent == info["transmissions"]
+    env_args = {"horizon_s": HORIZON_S[env_id], "randomize": True}
+    assert run_batch(env_id, trigger, [3], env_args)[0]["transmissions"] == sent
+
+
+def test_the_paper_rule_is_a_coupled_point() -> None:
+    """004 at unit weights, κ = 0, each axis sent alone: the paper's rule, record for record."""
+    env_id = "etsc/InnerFormation-v0"
+    coupled = FamilyPoint(coupling=Coupling((1.0, 1.0, 1.0), 0.0, refresh_all=False))
+    paper = PAPER_CLASSES[env_id]
+    for scenario in SEEDS:
+        expected = _records(env_id, lambda o, a, n, t: paper(o, a, n), scenario, full=False)
+        assert _records(env_id, _family(env_id, coupled), scenario, full=False) == expected
+
+
+def test_a_coupled_point_needs_one_weight_per_condition() -> None:
+    env = gym.make("etsc/InnerFormation-v0")
+    with pytest.raises(ValueError, match=r"weights must hold one weight per condition \(3\)"):
+        _coupled_trigger(env, FamilyPoint(coupling=Coupling((1.0, 1.0))))
+    for bad, message in [
+        ({"weights": [1.0, 0.0]}, r"point.coupling.weights' must hold one weight > 0"),
+        ({"weights": [1.0], "strength": 1.5}, r"point.coupling.strength"),
+        ({"weights": [1.0], "refresh_all": 1}, r"point.coupling.refresh_all"),
+        ({"strength": 0.5}, r"point.coupling"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            FamilyPoint.from_json({"coupling": bad})
+
+
 def test_learned_file_round_trips_and_refuses_other_files(tmp_path) -> None:
     env = gym.make("etsc/AttitudeTracking-v0")
     point = _modulated_point(env, 1)
@@ -225,6 +326,10 @@ def test_learned_file_round_trips_and_refuses_other_files(tmp_path) -> None:
     learned.save(path)
     loaded = LearnedTrigger.load(path)
     assert loaded.point.to_json() == point.to_json()
+    assert "coupling" not in json.loads(path.read_text())["point"]  # older files stay as they are
+    coupled = FamilyPoint(factors={"pi": 2.0}, coupling=Coupling((1.0, 0.5, 2.0), 0.25, False))
+    LearnedTrigger("etsc/InnerFormation-v0", "InnerFormationTrigger", coupled).save(path)
+    assert LearnedTrigger.load(path).point == coupled
     assert json.loads(path.read_text())["format"] == "etsc-envs/learned-trigger"
     path.write_text('{"format": "something else"}')
     with pytest.raises(ValueError, match=r"learned:.*format"):
@@ -238,6 +343,7 @@ def test_learned_file_round_trips_and_refuses_other_files(tmp_path) -> None:
         ({"floor_instants": -1.0}, "floor_instants"),
         ({"heartbeat_instants": 0.5}, "heartbeat_instants"),
         ({"exponent": float("nan")}, "exponent"),
+        ({"coupling": (1.0, 1.0)}, "coupling must be a Coupling"),
     ],
 )
 def test_bad_points_are_refused_naming_the_argument(keywords, message) -> None:

@@ -145,6 +145,27 @@ def test_the_exponent_box_is_the_configs() -> None:
     assert wide.decode([10.0]).exponent == 4.0
 
 
+def test_a_coupled_search_encodes_weights_and_strength() -> None:
+    """Searching ``coupling`` adds log2 of each condition's weight and κ to x; every candidate
+    keeps the start's refresh_all."""
+    start = {
+        "factors": {"pi": 6.0},
+        "exponent": 1.0,
+        "coupling": {"weights": [1.0, 0.5, 2.0], "strength": 0.25, "refresh_all": False},
+    }
+    config = _config(env_id="etsc/InnerFormation-v0", start=start, search=["factors", "coupling"])
+    space = SearchSpace(config, n_steps=40_000, modulation=None)
+    assert space.encode(config.start).tolist() == pytest.approx(
+        [math.log2(6.0), 0.0, -1.0, 1.0, 0.25]
+    )
+    point = space.decode([1.0, 2.0, 0.0, -3.0, 0.9])
+    assert point.coupling.weights == (4.0, 1.0, 0.125) and point.coupling.strength == 0.9
+    assert point.coupling.refresh_all is False
+    assert space.decode([1.0, 2.0, 0.0, -3.0, 7.0]).coupling.strength == 1.0  # κ's box
+    with pytest.raises(ValueError, match=r"search.start.coupling' gives the coupling"):
+        _config(env_id="etsc/InnerFormation-v0", start={}, search=["coupling"])
+
+
 def test_training_seeds_avoid_the_protocols_sets() -> None:
     config = _config(scenarios=64)
     for generation in (0, 1, 10_000):

@@ -8,7 +8,9 @@ The algorithm, in full:
 1. θ (the family's point) is encoded as a vector x: log2 of each searched threshold factor,
    log2 of the floor and of the heartbeat in sampling instants (below -1: no floor; above
    log2 of the horizon: no heartbeat), the time exponent p (in ``exponent_range``, default
-   [-1, 2]), and the network's weights when the
+   [-1, 2]), log2 of each channel's weight and the strength κ when the config searches a
+   coupled point (every candidate coupled as ``start.coupling``, whose ``refresh_all`` it
+   keeps), and the network's weights when the
    config searches a state-dependent modulation. x starts at the config's ``start`` point
    (today's best hand rule, so the search begins where the menu ended).
 2. Each generation, CMA-ES (pycma) asks for ``population`` candidates. Every candidate is
@@ -87,7 +89,7 @@ TRAINING_SEED_BASE = 10_000_000
 """Training scenario seeds start here (above the protocol's reserved ranges): run seed S,
 generation g, scenario i draws seed ``BASE + S · 1 000 000 + g · scenarios + i``."""
 
-DIMENSIONS = ("factors", "floor", "heartbeat", "exponent", "modulation")
+DIMENSIONS = ("factors", "floor", "heartbeat", "exponent", "coupling", "modulation")
 """The parts of θ a config may search."""
 
 LOG2_FACTOR_RANGE = 8.0
@@ -96,9 +98,16 @@ LOG2_FACTOR_RANGE = 8.0
 EXPONENT_RANGE = (-1.0, 2.0)
 """The time exponent p's box by default (a config's ``exponent_range`` replaces it)."""
 WEIGHT_RANGE = 4.0
-STEP_SCALE = {"factors": 1.0, "floor": 1.0, "heartbeat": 1.0, "exponent": 0.25, "modulation": 0.3}
-"""Initial step size of each part, relative to ``sigma`` (x is in log2 units for the first
-three)."""
+STEP_SCALE = {
+    "factors": 1.0,
+    "floor": 1.0,
+    "heartbeat": 1.0,
+    "exponent": 0.25,
+    "coupling": 0.5,
+    "modulation": 0.3,
+}
+"""Initial step size of each part, relative to ``sigma`` (x is in log2 units for the factors,
+the floor, the heartbeat and the coupling's weights)."""
 
 
 @dataclass(frozen=True)
@@ -211,6 +220,11 @@ def _checked_config(raw: dict[str, Any]) -> SearchConfig:
         )
     names = _observation_names(env_id, horizon_s)
     inputs = require_strings(raw.get("inputs", []), "search.inputs", names)
+    if "coupling" in search and start.coupling is None:
+        raise ValueError(
+            "key 'search.start.coupling' gives the coupling a search of coupling starts from "
+            "(e.g. {weights: [1, 1, 1], strength: 0} on 004's three axes)"
+        )
     if ("modulation" in search) != bool(inputs):
         raise ValueError(
             "key 'search.inputs' names the observations the network reads: needed by a search "
@@ -291,6 +305,12 @@ class SearchSpace:
                 lower.append(low)
                 upper.append(high)
                 steps.append(STEP_SCALE[part])
+        coupling = config.start.coupling if "coupling" in config.search else None
+        self.channels = 0 if coupling is None else len(coupling.weights)
+        if self.channels:  # log2 of each weight, then κ
+            lower += [-LOG2_FACTOR_RANGE] * self.channels + [0.0]
+            upper += [LOG2_FACTOR_RANGE] * self.channels + [1.0]
+            steps += [STEP_SCALE["coupling"]] * self.channels + [STEP_SCALE["exponent"]]
         if self.modulation is not None:
             n = self.modulation.weights.size
             lower += [-WEIGHT_RANGE] * n
@@ -307,6 +327,10 @@ class SearchSpace:
             x.append(self.no_heartbeat if math.isinf(beat) else math.log2(beat))
         if "exponent" in self.config.search:
             x.append(point.exponent)
+        if self.channels:
+            coupling = point.coupling or self.config.start.coupling
+            assert coupling is not None  # a search of coupling starts coupled
+            x.extend([*(math.log2(weight) for weight in coupling.weights), coupling.strength])
         if self.modulation is not None:
             modulation = point.modulation or self.modulation
             x.extend(modulation.weights)
@@ -332,6 +356,14 @@ class SearchSpace:
         if "exponent" in self.config.search:
             changes["exponent"] = float(x[i])
             i += 1
+        if self.channels:
+            assert start.coupling is not None  # a search of coupling starts coupled
+            changes["coupling"] = replace(
+                start.coupling,
+                weights=tuple(float(2.0**w) for w in x[i : i + self.channels]),
+                strength=float(x[i + self.channels]),
+            )
+            i += self.channels + 1
         if self.modulation is not None:
             changes["modulation"] = self.modulation.with_weights(x[i:])
         return replace(start, **changes)

@@ -166,7 +166,8 @@ class TriggerAction:
     def label(self, env_id: str) -> str:
         """The action in words: ``paper x2``, ``paper x2, heartbeat 384`` (sent first, capped),
         ``paper x4, floor 64``, ``paper x1, channel heartbeat 256``, ``error_time x2``; a
-        point's other parameters follow (``exponent 1``, ``first instant``, ``modulated``).
+        point's other parameters follow (``exponent 1``, ``first instant``, ``modulated``,
+        ``coupled (1, 0.5, 2) κ 1, all channels``).
         Factors of thresholds the rule's "× f" leaves alone (000's a1, a2) are not named."""
         point = self.point
         factor = self.factor(env_id)
@@ -188,6 +189,12 @@ class TriggerAction:
             text = f"{text}, first instant"
         if point.modulation is not None:
             text = f"{text}, modulated"
+        if point.coupling is not None:
+            coupling = point.coupling
+            weights = ", ".join(f"{weight:g}" for weight in coupling.weights)
+            text = f"{text}, coupled ({weights}) κ {coupling.strength:g}"
+            if coupling.refresh_all:
+                text = f"{text}, all channels"
         if self.send_first and point.floor_instants == 0.0:
             text = f"{text}, heartbeat {self.cap}"
         return text

@@ -19,6 +19,17 @@ the normalised observation, :class:`Modulation`), zero when it has no weights. T
 is applied to both sides so that every named point is its stand-alone policy's comparison to
 the last bit: with p = 0 and g = 0 both factors are exactly 1.
 
+A **coupled** point (:class:`Coupling`: a weight w > 0 per condition, a strength κ in [0, 1]
+and whether a send refreshes every channel) combines the conditions' ratios
+``r_cj = s_cj · τ_c^p / (h_cj · e^{g_h} · τ_ref^p)`` in a weighted norm: channel c's condition
+holds when ``Σ_j (w_cj r_cj)² + κ Σ_{d≠c} Σ_j (w_dj r_dj)² ⋗ 1``. Within a channel its
+conditions always combine (000's force and torque: the paper fires when either ratio reaches
+1, a max-norm; the coupled point on their weighted 2-norm); at κ = 1 every channel tests the
+norm of all conditions, a diagonal quadratic (Lyapunov-like) geometry over the channels; at
+κ = 0 with unit weights and one condition per channel it is the paper's condition per channel
+(004's three axes). With ``refresh_all`` any channel's send (condition, heartbeat, first
+instant) sends every channel.
+
 Named points (``tests/test_family.py`` checks each against its stand-alone policy):
 
 * the paper's rule: every factor 1, τ_min = 0, τ_max = ∞, p = 0, no first-instant send;
@@ -26,7 +37,9 @@ Named points (``tests/test_family.py`` checks each against its stand-alone polic
 * the rule with a heartbeat per channel: τ_max = (H - ½) T;
 * the rule gating a clock: τ_min = (F - ½) T;
 * the rule with raised thresholds: factors other than 1 (000's a1, a2 up to Theorem 2's K2j);
-* paper 004's error-time rule |r_i - r_i(t_k)| (t - t_k) > A_i: p = 1, τ_ref = 0.05 s.
+* paper 004's error-time rule |r_i - r_i(t_k)| (t - t_k) > A_i: p = 1, τ_ref = 0.05 s;
+* coupled at unit weights, κ = 0, without refresh_all, on a rule of one condition per channel
+  (004's): the point without coupling.
 
 Floors and heartbeats are given in sampling instants: a bound of K instants is reached K
 instants after a transmission (:func:`~etsc_envs.triggers.base.instants_seconds`).
@@ -216,6 +229,65 @@ class Modulation:
         return cls(inputs, **arrays)
 
 
+@dataclass(frozen=True)
+class Coupling:
+    """How a coupled point's channels decide together (see the module docstring).
+
+    Args:
+        weights: w > 0, one per condition of the rule: channel-major, each channel's
+            conditions in the rule's order (004: x, y, z; 000: torque, force).
+        strength: κ in [0, 1], how much the other channels' ratios count in a channel's
+            condition (1: every channel tests the weighted norm).
+        refresh_all: whether any channel's send sends every channel.
+    """
+
+    weights: tuple[float, ...]
+    strength: float = 1.0
+    refresh_all: bool = True
+
+    def __post_init__(self) -> None:
+        weights = tuple(float(weight) for weight in self.weights)
+        if not weights or not all(math.isfinite(w) and w > 0.0 for w in weights):
+            raise ValueError(
+                f"coupling.weights must be one finite weight > 0 per condition, got "
+                f"{self.weights!r}"
+            )
+        object.__setattr__(self, "weights", weights)
+        strength = float(self.strength)
+        if not 0.0 <= strength <= 1.0:
+            raise ValueError(f"coupling.strength must be a number in [0, 1], got {self.strength!r}")
+        object.__setattr__(self, "strength", strength)
+        object.__setattr__(
+            self, "refresh_all", require_bool(self.refresh_all, "coupling.refresh_all")
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "weights": list(self.weights),
+            "strength": self.strength,
+            "refresh_all": self.refresh_all,
+        }
+
+    @classmethod
+    def from_json(cls, data: Any, key: str = "coupling") -> Coupling:
+        """The coupling of the JSON form ``data`` (:meth:`to_json`; ``strength`` and
+        ``refresh_all`` default to 1 and true), each key checked (``ValueError`` naming it)."""
+        data = require_mapping(data, key, ("weights", "strength", "refresh_all"), ("weights",))
+        weights = require_array(data["weights"], f"{key}.weights", (None,))
+        if weights.size == 0 or not np.all(weights > 0.0):
+            raise ValueError(
+                f"key '{key}.weights' must hold one weight > 0 per condition, got "
+                f"{data['weights']!r}"
+            )
+        return cls(
+            weights=tuple(float(weight) for weight in weights),
+            strength=require_number(
+                data.get("strength", 1.0), f"{key}.strength", low=0.0, high=1.0
+            ),
+            refresh_all=require_bool(data.get("refresh_all", True), f"{key}.refresh_all"),
+        )
+
+
 def _non_negative_instants(name: str, value: Any) -> float:
     value = float(value)
     if math.isnan(value) or value < 0.0:
@@ -235,6 +307,8 @@ class FamilyPoint:
         exponent: p, the time exponent of the weighted condition.
         first_instant: send on every channel at the episode's first instant.
         modulation: the state-dependent network, or ``None`` (g = 0).
+        coupling: how the channels decide together (:class:`Coupling`), or ``None`` for the
+            paper's condition per channel.
     """
 
     factors: Mapping[str, float] = field(default_factory=dict)
@@ -243,6 +317,7 @@ class FamilyPoint:
     exponent: float = 0.0
     first_instant: bool = False
     modulation: Modulation | None = None
+    coupling: Coupling | None = None
 
     def __post_init__(self) -> None:
         factors = {}
@@ -267,6 +342,8 @@ class FamilyPoint:
             )
         object.__setattr__(self, "exponent", exponent)
         object.__setattr__(self, "first_instant", require_bool(self.first_instant, "first_instant"))
+        if self.coupling is not None and not isinstance(self.coupling, Coupling):
+            raise ValueError(f"coupling must be a Coupling or None, got {self.coupling!r}")
 
     @classmethod
     def clock(cls, every: int) -> FamilyPoint:
@@ -281,6 +358,7 @@ class FamilyPoint:
             "exponent": self.exponent,
             "first_instant": self.first_instant,
             "modulation": None if self.modulation is None else self.modulation.to_json(),
+            **({} if self.coupling is None else {"coupling": self.coupling.to_json()}),
         }
 
     @classmethod
@@ -291,6 +369,7 @@ class FamilyPoint:
         data = require_mapping(data, key, POINT_KEYS)
         factors = require_mapping(data.get("factors", {}), f"{key}.factors")
         modulation = data.get("modulation")
+        coupling = data.get("coupling")
         return cls(
             factors={
                 name: require_number(value, f"{key}.factors.{name}", low=0.0, low_open=True)
@@ -314,6 +393,7 @@ class FamilyPoint:
                 if modulation is None
                 else Modulation.from_json(modulation, f"{key}.modulation")
             ),
+            coupling=None if coupling is None else Coupling.from_json(coupling, f"{key}.coupling"),
         )
 
 
@@ -329,6 +409,7 @@ POINT_KEYS = (
     "exponent",
     "first_instant",
     "modulation",
+    "coupling",
 )
 """The keys of a point's JSON form."""
 
@@ -348,6 +429,56 @@ def dense_layer(parameters, offset, inputs, out, squash):
     return offset + n_out * n_in + n_out
 
 
+@jit
+def coupled_send(
+    observation,
+    time_indices,
+    coupling,
+    statistic,
+    threshold,
+    floor_s,
+    heartbeat_s,
+    first_s,
+    exponent,
+    threshold_scale,
+    strict,
+    out,
+):
+    """A coupled point's decision (the module docstring) into ``out``; ``coupling`` holds 1, κ,
+    refresh-all (1 or 0) and the conditions' weights. A condition whose threshold side is 0
+    counts as ratio ∞ where its statistic side is positive, 0 where it is not."""
+    channels = out.shape[0]
+    per_channel = statistic.shape[0] // channels
+    strength = coupling[1]
+    own = np.zeros(channels)
+    for channel in range(channels):
+        weight = float(observation[time_indices[channel]]) ** exponent
+        for j in range(per_channel):
+            k = channel * per_channel + j
+            side = statistic[k] * weight
+            bound = threshold[k] * threshold_scale
+            ratio = side / bound if bound > 0.0 else (np.inf if side > 0.0 else 0.0)
+            own[channel] += (coupling[3 + k] * ratio) ** 2
+    total = own.sum()
+    any_fires = 0
+    for channel in range(channels):
+        elapsed = float(observation[time_indices[channel]])
+        fires = 0
+        if elapsed < first_s or elapsed >= heartbeat_s:
+            fires = 1
+        elif elapsed >= floor_s:
+            mixed = own[channel]
+            if strength > 0.0:
+                mixed += strength * (total - own[channel])
+            if mixed > 1.0 if strict else mixed >= 1.0:
+                fires = 1
+        out[channel] = fires
+        any_fires = max(any_fires, fires)
+    if coupling[2] > 0.0 and any_fires:
+        for channel in range(channels):
+            out[channel] = 1
+
+
 @functools.cache
 def family_rule(
     condition: Callable[..., None], conditions_per_channel: int, strict: bool
@@ -359,7 +490,9 @@ def family_rule(
     indices, then the network's input indices, then five counts: the paper's indices, the
     paper's parameters, the inputs, and the two hidden widths (0 for no network).
     ``parameters`` holds the paper's (thresholds already scaled), then τ_min, τ_max, p,
-    τ_ref, τ_first (s), then the network's mean, scale, W1, b1, W2, b2, W3, b3.
+    τ_ref, τ_first (s), then 1 for a coupled point (else 0), κ, 1 to refresh all channels
+    (else 0) and the weights of the C × J conditions, then the network's mean, scale, W1, b1,
+    W2, b2, W3, b3.
     """
 
     @closure_jit
@@ -371,11 +504,12 @@ def family_rule(
         h1 = indices[m - 2]
         h2 = indices[m - 1]
         channels = out.shape[0]
+        n_conditions = channels * conditions_per_channel
         g_threshold = 0.0
         g_floor = 0.0
         g_heartbeat = 0.0
         if h1 > 0:
-            q = p0 + 5
+            q = p0 + 8 + n_conditions
             first_input = n_rule_indices + channels
             x = np.empty(n_inputs)
             for i in range(n_inputs):
@@ -399,10 +533,25 @@ def family_rule(
         exponent = parameters[p0 + 2]
         threshold_scale = np.exp(g_threshold) * parameters[p0 + 3] ** exponent
         first_s = parameters[p0 + 4]
-        n_conditions = channels * conditions_per_channel
         statistic = np.empty(n_conditions)
         threshold = np.empty(n_conditions)
         condition(observation, indices, parameters, statistic, threshold)
+        if parameters[p0 + 5] > 0.0:
+            coupled_send(
+                observation,
+                indices[n_rule_indices : n_rule_indices + channels],
+                parameters[p0 + 5 : p0 + 8 + n_conditions],
+                statistic,
+                threshold,
+                floor_s,
+                heartbeat_s,
+                first_s,
+                exponent,
+                threshold_scale,
+                strict,
+                out,
+            )
+            return
         for channel in range(channels):
             elapsed = float(observation[indices[n_rule_indices + channel]])
             fires = 0
@@ -518,6 +667,18 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
                 REFERENCE_S[trigger_class.__name__],
                 0.5 * period if point.first_instant else 0.0,
             ]
+            # 1, κ, refresh-all and the conditions' weights; zeros for the paper's geometry
+            coupling = point.coupling
+            conditions = channels * trigger_class.conditions_per_channel
+            if coupling is None:
+                coupled = [0.0] * (conditions + 3)
+            elif len(coupling.weights) == conditions:
+                coupled = [1.0, coupling.strength, float(coupling.refresh_all), *coupling.weights]
+            else:
+                raise ValueError(
+                    f"point.coupling.weights must hold one weight per condition ({conditions}), "
+                    f"got {len(coupling.weights)}"
+                )
             modulation = point.modulation
             if modulation is None:
                 inputs: list[int] = []
@@ -546,7 +707,12 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
                     len(inputs),
                     *hidden,
                 ],
-                parameters=[*inner.rule_parameters, *bounds, *network],
+                parameters=[
+                    *inner.rule_parameters,
+                    *bounds,
+                    *coupled,
+                    *network,
+                ],
                 keywords={"point": point, "sampling_period_s": period, **keywords},
             )
 
