@@ -58,6 +58,21 @@ def test_seeds_of_a_method_are_summarised_together(tmp_path: Path) -> None:
     assert (out / "learning_curves.png").stat().st_size > 0
 
 
+def test_the_interval_over_seeds_is_the_geometric_mean_of_the_runs(tmp_path: Path) -> None:
+    """Two runs whose cost ratios are 2 and 8 at every evaluation: the band's mean is their
+    geometric mean, 4, at every abscissa of their common range, its interval inside [2, 8];
+    one run alone has no band."""
+    runs = [_run(tmp_path / f"seed{cost:g}", [(cost, 50.0, 0)] * 4, 1) for cost in (2.0, 8.0)]
+    result = learning_curves(parse_runs([f"ppo={run}" for run in runs]), cost_tolerance=1.05)
+    band = result["methods"]["ppo"]["bands"]["env_steps"]
+    assert band["x"][0] == 10 and band["x"][-1] == 40
+    assert band["cost_ratio"]["geometric_mean"] == pytest.approx([4.0] * len(band["x"]))
+    assert all(2.0 - 1e-9 <= low <= high <= 8.0 + 1e-9 for low, high in band["cost_ratio"]["ci95"])
+    assert band["transmission_ratio"]["geometric_mean"] == pytest.approx([0.5] * len(band["x"]))
+    alone = learning_curves(parse_runs([f"ppo={runs[0]}"]), cost_tolerance=1.05)
+    assert alone["methods"]["ppo"]["bands"] is None
+
+
 @pytest.mark.parametrize("spec", ["no-separator", "=folder", "label="])
 def test_a_malformed_run_names_the_option(spec: str, capsys) -> None:
     with pytest.raises(SystemExit):

@@ -22,6 +22,12 @@ would be reached by a policy that transmits at every instant. The report gives, 
 instants and seconds it took (``null`` if it never did) and, per label, the median and range
 over the runs that reached it.
 
+Per label with two or more runs, ``bands`` holds the interval over seeds: on a grid of
+:data:`BAND_POINTS` abscissae across the range every run covers (instants, seconds), the
+geometric mean of the runs' ratios (each run interpolated in log ratio) with the 95 % bootstrap
+interval of that mean (:func:`~etsc_envs.evaluation.statistics.summarize` of the logs). The
+figure draws each band and its mean over the runs' own curves.
+
 Writes ``learning_curves.json`` and ``learning_curves.png`` (cost and transmissions relative to
 the paper trigger against instants and against seconds) into ``DIR`` (default
 ``results/learning_curves``).
@@ -40,10 +46,17 @@ import numpy as np
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.evaluation.arguments import write_json
+from etsc_envs.evaluation.statistics import summarize
 
 DEFAULT_COST_TOLERANCE = 1.05
 """The goal's cost tolerance: within 5 % of the paper trigger's ``mean_cost``."""
 
+
+BAND_POINTS = 40
+"""Abscissae of a label's interval over seeds."""
+
+AXES = ("env_steps", "wall_time_s")
+RATIOS = ("cost_ratio", "transmission_ratio")
 
 RUN_RECORDS = ("evaluations.json", "generations.jsonl")
 """A training run's validation record (``agents.train``) or a search's (``agents.search``)."""
@@ -146,6 +159,36 @@ def _spread(values: list[float]) -> dict[str, Any]:
     return {"median": float(np.median(values)), "range": [min(values), max(values)]}
 
 
+def seed_bands(runs: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The interval over seeds of the module docstring for one label's runs (``None`` for
+    fewer than two, or where their abscissae share no range)."""
+    if len(runs) < 2:
+        return None
+    bands: dict[str, Any] = {}
+    for x_key in AXES:
+        curves = [[(p[x_key], p) for p in run["points"]] for run in runs]
+        low = max(curve[0][0] for curve in curves)
+        high = min(curve[-1][0] for curve in curves)
+        if not high > low:
+            return None
+        grid = np.linspace(low, high, BAND_POINTS)
+        band: dict[str, Any] = {"x": grid.tolist()}
+        for y_key in RATIOS:
+            logs = np.array(
+                [
+                    np.interp(grid, [x for x, _ in curve], [np.log(p[y_key]) for _, p in curve])
+                    for curve in curves
+                ]
+            )
+            summaries = [summarize(column) for column in logs.T]
+            band[y_key] = {
+                "geometric_mean": [float(np.exp(item["mean"])) for item in summaries],
+                "ci95": [[float(np.exp(v)) for v in item["mean_ci95"]] for item in summaries],
+            }
+        bands[x_key] = band
+    return bands
+
+
 def learning_curves(
     runs: list[tuple[str, Path]],
     cost_tolerance: float,
@@ -167,6 +210,7 @@ def learning_curves(
     for label, folder in runs:
         methods.setdefault(label, {"runs": []})["runs"].append(run_curve(folder, cost_tolerance))
     for method in methods.values():
+        method["bands"] = seed_bands(method["runs"])
         if "reached" in method:
             continue
         reached = [run for run in method["runs"] if run["reached_at_env_steps"] is not None]
@@ -182,19 +226,40 @@ def plot(result: dict[str, Any], path: Path) -> None:
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for index, (label, method) in enumerate(result["methods"].items()):
         colour = colours[index % len(colours)]
+        bands = method.get("bands")
+        seeds = len(method["runs"])
         for run_index, run in enumerate(method["runs"]):
             points = run["points"]
-            for column, x_key in enumerate(("env_steps", "wall_time_s")):
+            for column, x_key in enumerate(AXES):
                 x = [point[x_key] for point in points]
-                for row, y_key in enumerate(("cost_ratio", "transmission_ratio")):
+                for row, y_key in enumerate(RATIOS):
                     axes[row, column].plot(
                         x,
                         [point[y_key] for point in points],
                         color=colour,
-                        alpha=0.8,
-                        marker=".",
-                        label=label if run_index == 0 and row == column == 0 else None,
+                        alpha=0.25 if bands else 0.8,
+                        linewidth=0.8 if bands else 1.5,
+                        marker="" if bands else ".",
+                        label=(
+                            f"{label} (1 run)"
+                            if not bands and run_index == 0 and row == column == 0
+                            else None
+                        ),
                     )
+        if not bands:
+            continue
+        for column, x_key in enumerate(AXES):
+            band = bands[x_key]
+            for row, y_key in enumerate(RATIOS):
+                low, high = np.array(band[y_key]["ci95"]).T
+                axes[row, column].fill_between(band["x"], low, high, color=colour, alpha=0.25)
+                axes[row, column].plot(
+                    band["x"],
+                    band[y_key]["geometric_mean"],
+                    color=colour,
+                    linewidth=2.0,
+                    label=f"{label} ({seeds} runs)" if row == column == 0 else None,
+                )
     for row, name in enumerate(("mean_cost / paper", "transmissions / paper")):
         axes[row, 0].set_ylabel(name)
         for column in range(2):
@@ -203,10 +268,16 @@ def plot(result: dict[str, Any], path: Path) -> None:
             axes[row, column].grid(True, which="major", alpha=0.3)
     for column in range(2):
         axes[0, column].axhline(result["cost_tolerance"], color="k", linewidth=0.8, linestyle="--")
+    for row in range(2):  # budgets span 10^6 (PPO) to 10^8 (a large search) instants
+        axes[row, 0].set_xscale("log")
     axes[1, 0].set_xlabel("sampling instants simulated for training")
     axes[1, 1].set_xlabel("training wall time (s)")
     figure.legend(loc="lower center", ncol=4, frameon=False)
-    figure.suptitle("validation scenarios: learned trigger relative to the paper's", fontsize=11)
+    figure.suptitle(
+        "validation scenarios: learned trigger relative to the paper's (thin: runs; bold and "
+        "shaded: geometric mean over seeds, 95 % interval)",
+        fontsize=10,
+    )
     figure.tight_layout(rect=(0, 0.06, 1, 0.95))
     save(figure, path)
 
