@@ -430,23 +430,13 @@ def dense_layer(parameters, offset, inputs, out, squash):
 
 
 @jit
-def coupled_send(
-    observation,
-    time_indices,
-    coupling,
-    statistic,
-    threshold,
-    floor_s,
-    heartbeat_s,
-    first_s,
-    exponent,
-    threshold_scale,
-    strict,
-    out,
-):
+def coupled_send(observation, time_indices, coupling, statistic, threshold, limits, strict, out):
     """A coupled point's decision (the module docstring) into ``out``; ``coupling`` holds 1, κ,
-    refresh-all (1 or 0) and the conditions' weights. A condition whose threshold side is 0
-    counts as ratio ∞ where its statistic side is positive, 0 where it is not."""
+    refresh-all (1 or 0) and the conditions' weights, ``limits`` the floor, heartbeat and
+    first-instant times (s), p and the thresholds' scale e^{g_h} τ_ref^p. A condition whose
+    threshold side is 0 counts as ratio ∞ where its statistic side is positive, 0 where it is
+    not."""
+    floor_s, heartbeat_s, first_s, exponent, threshold_scale = limits
     channels = out.shape[0]
     per_channel = statistic.shape[0] // channels
     strength = coupling[1]
@@ -543,11 +533,7 @@ def family_rule(
                 parameters[p0 + 5 : p0 + 8 + n_conditions],
                 statistic,
                 threshold,
-                floor_s,
-                heartbeat_s,
-                first_s,
-                exponent,
-                threshold_scale,
+                (floor_s, heartbeat_s, first_s, exponent, threshold_scale),
                 strict,
                 out,
             )
