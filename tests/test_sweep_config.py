@@ -154,12 +154,15 @@ def _penalties(config: SweepConfig) -> list[float]:
 def test_a_shipped_front_crosses_penalties_with_three_seeds(path: Path) -> None:
     """Every shipped sweep is a front: at least two penalties (a refinement between two
     penalties of a wider front, e.g. a larger search budget near the headline's rate) and three
-    seeds."""
+    seeds; or a chosen configuration over five seeds or more."""
     config = load_sweep_config(path)
     assert config.kind == "front"
     assert Path(config.results_dir).parts[-3:-1] == ("runs", "sweeps")
     if config.learner == "oracle":  # one clairvoyant search per scenario of the first 16
         assert config.grid == {"scenario": list(range(16))}
+        return
+    if set(config.grid) == {"seed"}:
+        assert len(config.grid["seed"]) >= 5
         return
     assert len(_penalties(config)) >= 2
     assert len(config.grid["seed"]) >= 3

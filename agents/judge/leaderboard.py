@@ -116,6 +116,20 @@ class Board:
         return f"{self.name}_learned_front"
 
 
+def self_triggered_front(env_id: str, problem: str) -> str:
+    """The commands behind a self-triggered PPO row: the front
+    ``configs/sweeps/<problem>_self_triggered_front.yaml`` (penalties × seeds), the penalty
+    chosen on validation, and the judgement of the sweep's groups."""
+    sweep = f"runs/sweeps/{problem}_self_triggered_front"
+    name = env_id.removeprefix("etsc/")
+    return (
+        f"python -m agents.sweep --processes 2 --config configs/sweeps/"
+        f"{problem}_self_triggered_front.yaml && python -m agents.judge.penalty_choice {sweep} && "
+        f"python -m agents.results {env_id} --sweep {sweep} "
+        f"--out docs/results/{name}_self_triggered_scratch"
+    )
+
+
 BOARDS = (
     Board("etsc/OrbitAttitudeTracking-v0", "000", "OrbitAttitudeTracking-v0_learned_large_budget"),
     Board("etsc/ClusterContainment-v0", "001", "ClusterContainment-v0_learned"),
@@ -127,23 +141,16 @@ BOARDS = (
         "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
         "holds or eq. (27) × f from scratch, 5 seeds at λ = 300, best-validation checkpoints "
         "(no λ of 100, 300 contained the paper rule on validation; 300 came closest)",
-        "python -m agents.sweep --processes 2 --config "
-        "configs/sweeps/attitude_tracking_self_triggered_front.yaml && "
-        "python -m agents.judge.penalty_choice "
-        "runs/sweeps/attitude_tracking_self_triggered_front && python -m agents.results "
-        "etsc/AttitudeTracking-v0 --sweep runs/sweeps/attitude_tracking_self_triggered_front "
-        "--out docs/results/AttitudeTracking-v0_self_triggered_scratch",
+        self_triggered_front("etsc/AttitudeTracking-v0", "attitude_tracking"),
     ),
     Board(
         "etsc/AsteroidOrbitKeeping-v0",
         "003",
         "AsteroidOrbitKeeping-v0_learned",
-        "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=1",
-        "holds or eq. (15) × f from scratch at λ = 1, one seed (before the protocol's five)",
-        "python -m agents.sweep --config configs/sweeps/asteroid_self_triggered_front.yaml && "
-        "python -m agents.results etsc/AsteroidOrbitKeeping-v0 "
-        "--sweep runs/sweeps/asteroid_self_triggered_front "
-        "--out docs/results/AsteroidOrbitKeeping-v0_self_triggered_scratch",
+        "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
+        "holds or eq. (15) × f from scratch, 5 seeds at λ = 0.3 chosen on validation from 0.3, "
+        "1, 3, 10, best-validation checkpoints",
+        self_triggered_front("etsc/AsteroidOrbitKeeping-v0", "asteroid"),
     ),
     Board("etsc/InnerFormation-v0", "004", "InnerFormation-v0_learned_large_budget"),
 )
