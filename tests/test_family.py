@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import gymnasium as gym
@@ -423,8 +424,10 @@ def test_every_id_ships_its_hand_point() -> None:
 @pytest.mark.parametrize("path", HAND_FILES, ids=lambda path: path.name)
 def test_a_hand_point_is_where_its_search_starts_and_names_its_menu(path: Path) -> None:
     """``models/<id>_hand.json`` is a point of the id's family (it loads with ``learned:``),
-    says what menu it was chosen from, and is the start of the id's search config: the
-    learned trigger is searched from the hand point it is judged against."""
+    says what menu it was chosen from, and is the start of each of the id's search configs: the
+    learned trigger is searched from the hand point it is judged against (a coupled search
+    from the hand point as the coupled point of its own geometry: unit weights, κ = 0, each
+    channel sent alone)."""
     import yaml
 
     import etsc_envs
@@ -438,8 +441,15 @@ def test_a_hand_point_is_where_its_search_starts_and_names_its_menu(path: Path) 
         for config in Path(__file__).parents[1].glob("configs/search/*.yaml")
         if yaml.safe_load(config.read_text())["env_id"] == hand.env_id
     ]
-    assert len(configs) == 1, configs
-    assert load_config(configs[0]).start.to_json() == hand.point.to_json()
+    assert configs
+    for config in configs:
+        start = load_config(config).start
+        coupling = start.coupling
+        if coupling is not None:
+            assert set(coupling.weights) == {1.0} and coupling.strength == 0.0, config
+            assert not coupling.refresh_all, config
+            start = replace(start, coupling=None)
+        assert start.to_json() == hand.point.to_json(), config
     if hand.env_id in etsc_envs.ENV_IDS:
         env = gym.make(hand.env_id)
         policy = etsc_envs.load_policy(f"learned:{path}", env)
