@@ -71,6 +71,11 @@ def test_the_interval_over_seeds_is_the_geometric_mean_of_the_runs(tmp_path: Pat
     assert band["transmission_ratio"]["geometric_mean"] == pytest.approx([0.5] * len(band["x"]))
     alone = learning_curves(parse_runs([f"ppo={runs[0]}"]), cost_tolerance=1.05)
     assert alone["methods"]["ppo"]["bands"] is None
+    free = _run(tmp_path / "cost0", [(0.0, 50.0, 0)] * 4, 1)  # 003 keeps its shell at cost 0
+    result = learning_curves(parse_runs([f"ppo={runs[0]}", f"ppo={free}"]), cost_tolerance=1.05)
+    band = result["methods"]["ppo"]["bands"]["env_steps"]
+    assert band["cost_ratio"] is None  # 0 has no logarithm
+    assert band["transmission_ratio"]["geometric_mean"] == pytest.approx([0.5] * len(band["x"]))
 
 
 @pytest.mark.parametrize("spec", ["no-separator", "=folder", "label="])

@@ -161,23 +161,27 @@ def _spread(values: list[float]) -> dict[str, Any]:
 
 def seed_bands(runs: list[dict[str, Any]]) -> dict[str, Any] | None:
     """The interval over seeds of the module docstring for one label's runs (``None`` for
-    fewer than two, or where their abscissae share no range)."""
+    fewer than two, or where their abscissae share no range; a ratio's band is ``None`` where
+    a run's ratio reaches 0, which has no logarithm)."""
     if len(runs) < 2:
         return None
     bands: dict[str, Any] = {}
     for x_key in AXES:
-        curves = [[(p[x_key], p) for p in run["points"]] for run in runs]
-        low = max(curve[0][0] for curve in curves)
-        high = min(curve[-1][0] for curve in curves)
+        low = max(run["points"][0][x_key] for run in runs)
+        high = min(run["points"][-1][x_key] for run in runs)
         if not high > low:
             return None
         grid = np.linspace(low, high, BAND_POINTS)
         band: dict[str, Any] = {"x": grid.tolist()}
         for y_key in RATIOS:
+            values = [np.array([point[y_key] for point in run["points"]]) for run in runs]
+            if any(np.any(ratios <= 0.0) for ratios in values):
+                band[y_key] = None
+                continue
             logs = np.array(
                 [
-                    np.interp(grid, [x for x, _ in curve], [np.log(p[y_key]) for _, p in curve])
-                    for curve in curves
+                    np.interp(grid, [point[x_key] for point in run["points"]], np.log(ratios))
+                    for run, ratios in zip(runs, values, strict=True)
                 ]
             )
             summaries = [summarize(column) for column in logs.T]
@@ -241,7 +245,7 @@ def plot(result: dict[str, Any], path: Path) -> None:
                         linewidth=0.8 if bands else 1.5,
                         marker="" if bands else ".",
                         label=(
-                            f"{label} (1 run)"
+                            f"{label} ({seeds} run{'s' if seeds > 1 else ''})"
                             if not bands and run_index == 0 and row == column == 0
                             else None
                         ),
@@ -251,6 +255,8 @@ def plot(result: dict[str, Any], path: Path) -> None:
         for column, x_key in enumerate(AXES):
             band = bands[x_key]
             for row, y_key in enumerate(RATIOS):
+                if band[y_key] is None:
+                    continue
                 low, high = np.array(band[y_key]["ci95"]).T
                 axes[row, column].fill_between(band["x"], low, high, color=colour, alpha=0.25)
                 axes[row, column].plot(

@@ -8,7 +8,7 @@ The algorithm, in full:
 1. θ (the family's point) is encoded as a vector x: log2 of each searched threshold factor,
    log2 of the floor and of the heartbeat in sampling instants (below -1: no floor; above
    log2 of the horizon: no heartbeat), the time exponent p (in ``exponent_range``, default
-   [-1, 2]), log2 of each channel's weight and the strength κ when the config searches a
+   [-1, 2]), log2 of each condition's weight and the strength κ when the config searches a
    coupled point (every candidate coupled as ``start.coupling``, whose ``refresh_all`` it
    keeps), and the network's weights when the
    config searches a state-dependent modulation. x starts at the config's ``start`` point
@@ -306,11 +306,11 @@ class SearchSpace:
                 upper.append(high)
                 steps.append(STEP_SCALE[part])
         coupling = config.start.coupling if "coupling" in config.search else None
-        self.channels = 0 if coupling is None else len(coupling.weights)
-        if self.channels:  # log2 of each weight, then κ
-            lower += [-LOG2_FACTOR_RANGE] * self.channels + [0.0]
-            upper += [LOG2_FACTOR_RANGE] * self.channels + [1.0]
-            steps += [STEP_SCALE["coupling"]] * self.channels + [STEP_SCALE["exponent"]]
+        self.coupling_weights = 0 if coupling is None else len(coupling.weights)
+        if self.coupling_weights:  # log2 of each condition's weight, then κ
+            lower += [-LOG2_FACTOR_RANGE] * self.coupling_weights + [0.0]
+            upper += [LOG2_FACTOR_RANGE] * self.coupling_weights + [1.0]
+            steps += [STEP_SCALE["coupling"]] * self.coupling_weights + [STEP_SCALE["exponent"]]
         if self.modulation is not None:
             n = self.modulation.weights.size
             lower += [-WEIGHT_RANGE] * n
@@ -327,7 +327,7 @@ class SearchSpace:
             x.append(self.no_heartbeat if math.isinf(beat) else math.log2(beat))
         if "exponent" in self.config.search:
             x.append(point.exponent)
-        if self.channels:
+        if self.coupling_weights:
             coupling = point.coupling or self.config.start.coupling
             assert coupling is not None  # a search of coupling starts coupled
             x.extend([*(math.log2(weight) for weight in coupling.weights), coupling.strength])
@@ -356,14 +356,15 @@ class SearchSpace:
         if "exponent" in self.config.search:
             changes["exponent"] = float(x[i])
             i += 1
-        if self.channels:
+        if self.coupling_weights:
             assert start.coupling is not None  # a search of coupling starts coupled
+            n = self.coupling_weights
             changes["coupling"] = replace(
                 start.coupling,
-                weights=tuple(float(2.0**w) for w in x[i : i + self.channels]),
-                strength=float(x[i + self.channels]),
+                weights=tuple(float(2.0**w) for w in x[i : i + n]),
+                strength=float(x[i + n]),
             )
-            i += self.channels + 1
+            i += n + 1
         if self.modulation is not None:
             changes["modulation"] = self.modulation.with_weights(x[i:])
         return replace(start, **changes)
