@@ -193,6 +193,8 @@ def safe_load_objects(
     objects.update(
         {key: value for key, value in ACTING_PLACEHOLDERS.items() if key in record["serialized"]}
     )
+    # an off-policy model acts without its replay buffer: one transition of the default class
+    objects.update({"replay_buffer_kwargs": {}, "buffer_size": 1})
     return objects
 
 

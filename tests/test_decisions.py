@@ -459,6 +459,49 @@ def test_agents_train_takes_decisions_and_saves_deployable_models(tmp_path):
     assert result["episodes"][0]["transmissions"] > 0
 
 
+def test_agents_train_runs_dqn_on_decisions_and_resumes(tmp_path):
+    """DQN takes self-triggered decisions with the semi-Markov target (its replay buffer
+    discounts by elapsed instants), saves a deployable model, and resumes from a checkpoint."""
+    import yaml
+
+    from agents.train.elapsed_discount import ElapsedReplayBuffer
+    from agents.train.training import _build_model, main, make_training_env
+
+    out_dir = tmp_path / "run"
+    config = {
+        "env_id": FORMATION,
+        "env_kwargs": {"horizon_s": 0.1},
+        "algorithm": "DQN",
+        "policy": "MlpPolicy",
+        "hyperparameters": {
+            "learning_starts": 8,
+            "batch_size": 8,
+            "buffer_size": 256,
+            "gamma": 0.999,
+        },
+        "total_timesteps": 32,
+        "out_dir": str(out_dir),
+        "decisions": rule_block(FORMATION, max_exponent=3),
+        "checkpoint_every": 16,
+        "tensorboard": False,
+    }
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(config), encoding="utf-8")
+    assert main(["--config", str(path)]) == 0
+    from agents.train.config import load_config
+
+    loaded = load_config(path)
+    model = _build_model(loaded, make_training_env(loaded, None), None, out_dir)
+    assert isinstance(model.replay_buffer, ElapsedReplayBuffer)
+    assert model.replay_buffer.gamma == 0.999
+    result = evaluate(FORMATION, f"sb3:{out_dir / 'model.zip'}", env_args={"horizon_s": 0.1})
+    assert result["episodes"][0]["transmissions"] > 0
+    path.write_text(yaml.safe_dump({**config, "total_timesteps": 48}), encoding="utf-8")
+    assert main(["--config", str(path), "--resume"]) == 0
+    summary = json.loads((out_dir / "train_summary.json").read_text(encoding="utf-8"))
+    assert summary["resumed_from"] is not None
+
+
 HOLD_1 = {"actions": [{"kind": "hold", "instants": 1}]}
 """A config's decisions block of one action, "hold 1"."""
 ERROR_TIME = {"kind": "trigger", "rule": "error_time"}

@@ -49,8 +49,9 @@ A config is a YAML mapping with these keys (the optional ones show their default
   point: {...}, cap: N, send_first: ...}``; ``env_id`` is the config's), trained from a random
   policy through :class:`etsc_envs.decisions.SelfTriggeredWrapper` (its ``gamma`` is
   ``hyperparameters.gamma``) on a ``DummyVecEnv`` of wrapped envs (for a PettingZoo id, of
-  :class:`etsc_envs.decisions.FollowerDecisionEnv`). PPO, A2C and MaskablePPO then discount
-  by elapsed instants (:mod:`agents.train.elapsed_discount`); the models are saved with their
+  :class:`etsc_envs.decisions.FollowerDecisionEnv`). PPO, A2C, MaskablePPO and DQN then
+  discount by elapsed instants (:mod:`agents.train.elapsed_discount`; DQN's target is
+  ``r + gamma ** n * max Q'``); the models are saved with their
   decision set beside them, so that ``sb3:`` deploys them as transmit/hold policies;
 * ``torch_threads: 1`` — threads PyTorch may use. The policies are small MLPs, whose
   batches of a few dozen rows run fastest on one thread; more threads contend with the

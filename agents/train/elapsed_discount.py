@@ -1,4 +1,4 @@
-"""Discounting by elapsed time for Stable-Baselines3's on-policy algorithms.
+"""Discounting by elapsed time for Stable-Baselines3's algorithms.
 
 Between two self-triggered decisions ``n`` sampling instants apart
 (:class:`etsc_envs.decisions.SelfTriggeredWrapper`, ``info["elapsed_steps"] = n``) the return
@@ -14,15 +14,27 @@ step's infos (a transition without ``elapsed_steps`` counts one instant)::
 
 Where an episode is cut by its horizon, SB3 adds ``gamma`` times the value of the cut state to
 the last reward, one instant's discount rather than ``gamma ** n``.
+
+DQN's target is the semi-Markov one, ``r + gamma ** n * max_a Q'(s', a)``, with
+:class:`ElapsedReplayBuffer`, which reads ``n`` from the infos it is given with each transition
+and returns ``gamma ** n`` as the samples' ``discounts`` (SB3's DQN uses them in place of
+``gamma``; a cut episode's bootstrap is discounted by its ``n`` too)::
+
+    model = DQN("MlpPolicy", wrapped_env, gamma=0.999,
+                replay_buffer_class=ElapsedReplayBuffer, replay_buffer_kwargs={"gamma": 0.999})
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import torch
 from sb3_contrib.common.maskable.buffers import MaskableRolloutBuffer
-from stable_baselines3.common.buffers import RolloutBuffer
+from stable_baselines3.common.buffers import ReplayBuffer, RolloutBuffer
 from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.type_aliases import ReplayBufferSamples
+from stable_baselines3.common.vec_env import VecNormalize
 
 
 class ElapsedDiscountMixin:
@@ -89,7 +101,54 @@ class ElapsedStepsCallback(BaseCallback):
             )
 
     def _on_step(self) -> bool:
-        infos = self.locals["infos"]
-        elapsed = np.array([info.get("elapsed_steps", 1) for info in infos], dtype=np.float32)
-        self.model.rollout_buffer.record_elapsed(elapsed)
+        self.model.rollout_buffer.record_elapsed(elapsed_steps(self.locals["infos"]))
         return True
+
+
+def elapsed_steps(infos: list[dict[str, Any]]) -> np.ndarray:
+    """Each info's ``elapsed_steps`` (one instant where a transition has none)."""
+    return np.array([info.get("elapsed_steps", 1) for info in infos], dtype=np.float32)
+
+
+class ElapsedReplayBuffer(ReplayBuffer):
+    """SB3's ``ReplayBuffer`` whose samples discount transition ``t`` by ``gamma ** n_t``
+    (``discounts``), ``n_t`` read from ``info["elapsed_steps"]`` when the transition is added.
+
+    Args:
+        gamma: the per-instant discount (the algorithm's ``gamma``).
+        *args, **kwargs: ``ReplayBuffer``'s; ``optimize_memory_usage`` is refused.
+    """
+
+    def __init__(self, *args: Any, gamma: float = 0.99, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if self.optimize_memory_usage:
+            raise ValueError("ElapsedReplayBuffer: optimize_memory_usage is not supported")
+        self.gamma = float(gamma)
+        self.elapsed = np.ones((self.buffer_size, self.n_envs), dtype=np.float32)
+
+    def add(
+        self,
+        obs: np.ndarray,
+        next_obs: np.ndarray,
+        action: np.ndarray,
+        reward: np.ndarray,
+        done: np.ndarray,
+        infos: list[dict[str, Any]],
+    ) -> None:
+        self.elapsed[self.pos] = elapsed_steps(infos)
+        super().add(obs, next_obs, action, reward, done, infos)
+
+    def _get_samples(
+        self, batch_inds: np.ndarray, env: VecNormalize | None = None
+    ) -> ReplayBufferSamples:
+        """``ReplayBuffer``'s samples with their ``discounts``. Its one draw is the env index
+        of each sample, from NumPy's global generator; the draw is repeated from the same
+        generator state to find them, and the generator left as that draw left it."""
+        before = np.random.get_state()
+        samples = super()._get_samples(batch_inds, env)
+        after = np.random.get_state()
+        np.random.set_state(before)
+        env_indices = np.random.randint(0, high=self.n_envs, size=(len(batch_inds),))
+        np.random.set_state(after)
+        discounts = self.gamma ** self.elapsed[batch_inds, env_indices].reshape(-1, 1)
+        return samples._replace(discounts=self.to_torch(discounts))

@@ -58,6 +58,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecMonitor, Ve
 import etsc_envs
 from agents.train.config import TrainConfig, load_config
 from agents.train.elapsed_discount import (
+    ElapsedReplayBuffer,
     ElapsedRolloutBuffer,
     ElapsedStepsCallback,
     MaskableElapsedRolloutBuffer,
@@ -316,11 +317,7 @@ def _build_model(
             seed=config.seed,
             tensorboard_log=tensorboard_log,
             **config.hyperparameters,
-            **(
-                {"rollout_buffer_class": ELAPSED_BUFFERS[config.algorithm]}
-                if _discounts_elapsed_instants(config)
-                else {}
-            ),
+            **_elapsed_discount_kwargs(config),
         ),
         exceptions=(AssertionError, TypeError, ValueError),
     )
@@ -331,8 +328,24 @@ def _build_model(
 
 
 def _discounts_elapsed_instants(config: TrainConfig) -> bool:
-    """Whether the run discounts self-triggered decisions by elapsed instants."""
+    """Whether the run's rollout buffer discounts self-triggered decisions by elapsed instants
+    (and needs :class:`ElapsedStepsCallback` to tell it them)."""
     return config.decisions is not None and config.algorithm in ELAPSED_BUFFERS
+
+
+def _elapsed_discount_kwargs(config: TrainConfig) -> dict[str, Any]:
+    """The algorithm's keyword arguments that discount self-triggered decisions by elapsed
+    instants: an elapsed rollout buffer, or for DQN the replay buffer whose target is
+    ``r + gamma ** n * max Q'`` (none for per-instant decisions)."""
+    if _discounts_elapsed_instants(config):
+        return {"rollout_buffer_class": ELAPSED_BUFFERS[config.algorithm]}
+    if config.decisions is not None and config.algorithm == "DQN":
+        gamma = config.hyperparameters.get("gamma", 0.99)
+        return {
+            "replay_buffer_class": ElapsedReplayBuffer,
+            "replay_buffer_kwargs": {"gamma": gamma},
+        }
+    return {}
 
 
 def training_decision_env(config: TrainConfig) -> gym.Env:
