@@ -4,6 +4,7 @@ as the largest whose seeds' mean chosen point contains the start's."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -73,6 +74,23 @@ def test_an_unfinished_trial_is_refused(tmp_path: Path, capsys) -> None:
     with pytest.raises(SystemExit):
         main([str(front)])
     assert "is incomplete; finish the sweep first" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("summary", "message"),
+    [
+        (None, r"RESULTS_DIR: '.*' holds no sweep_summary\.json"),
+        ("{not json", r"RESULTS_DIR: .*sweep_summary\.json is not readable JSON"),
+        ('{"sweep": "x"}', r"RESULTS_DIR: .*sweep_summary\.json is not a sweep summary"),
+    ],
+)
+def test_a_folder_that_is_not_a_sweep_is_named(tmp_path: Path, capsys, summary, message) -> None:
+    if summary is not None:
+        (tmp_path / "sweep_summary.json").write_text(summary)
+    with pytest.raises(SystemExit):
+        main([str(tmp_path)])
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert re.search(message, error), error
 
 
 def _training_front(tmp_path: Path, runs: dict[tuple[float, int], list[tuple]]) -> Path:

@@ -247,3 +247,19 @@ def test_search_benchmark_counts_every_env_step_it_times() -> None:
     validation = 2 * 50_000  # the paper's 50 s at 1 ms
     assert steps == training + validation
     assert cpu > 0.0 and wall > 0.0
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--config", "no/such.yaml"], "--config no/such.yaml: not a readable YAML file"),
+        (["--generations", "0"], "--generations must be an integer >= 1, got 0"),
+        (["--repeats", "-2"], "--repeats must be an integer >= 1, got -2"),
+    ],
+)
+def test_search_benchmark_refuses_bad_arguments_in_one_line(capsys, argv, message) -> None:
+    from agents.bench.search import main
+
+    with pytest.raises(SystemExit):
+        main(argv)
+    assert message in capsys.readouterr().err.strip().splitlines()[-1]

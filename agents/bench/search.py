@@ -59,10 +59,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--generations", type=int, default=1, help="generations per timed run")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs per config")
     args = parser.parse_args(argv)
-    if args.generations < 1 or args.repeats < 1:
-        parser.error("--generations and --repeats must be >= 1")
-    for path in args.config or DEFAULT_CONFIGS:
-        config = replace(load_config(path), generations=args.generations)
+    for name in ("generations", "repeats"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name} must be an integer >= 1, got {getattr(args, name)}")
+    try:  # every config is checked before the first is timed
+        configs = [load_config(path) for path in args.config or DEFAULT_CONFIGS]
+    except ValueError as error:
+        parser.error(str(error))
+    for path, loaded in zip(args.config or DEFAULT_CONFIGS, configs, strict=True):
+        config = replace(loaded, generations=args.generations)
         for name, values in rates(config, args.repeats).items():
             print(
                 f"{config.env_id} ({path}), env steps/s {name.replace('_', ' ')}: "

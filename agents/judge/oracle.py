@@ -45,7 +45,7 @@ def read_runs(results_dir: str | Path) -> list[dict[str, Any]]:
     """Every finished trial's record of a ``learner: oracle`` sweep, by scenario seed;
     ``ValueError`` naming ``SWEEP_DIR`` if a trial did not finish, none did, or they judge
     another id or trigger than the first."""
-    trials = read_sweep(results_dir)
+    trials = read_sweep(results_dir, "SWEEP_DIR")
     unfinished = [trial.name for trial in trials if trial.status != "finished"]
     if unfinished:
         raise ValueError(f"SWEEP_DIR: trials {unfinished} of {results_dir} did not finish")
@@ -161,10 +161,10 @@ def main(argv: list[str] | None = None) -> int:
         records = read_runs(args.sweep_dir)
         require_own_record(out, records)
     except ValueError as error:
-        print(f"error: {str(error).replace('--sweep', 'SWEEP_DIR')}", file=sys.stderr)
+        print(f"error: {error}", file=sys.stderr)
         return 2
     summary = judge(records)
-    sweep = read_summary(args.sweep_dir).get("sweep")
+    sweep = read_summary(args.sweep_dir, "SWEEP_DIR").get("sweep")
     summary["commands"] = [
         *([f"python -m agents.sweep --config {sweep} --processes 2 --resume"] if sweep else []),
         f"python -m agents.judge.oracle {args.sweep_dir} --out {args.out}",

@@ -95,7 +95,7 @@ def choose_penalty(results_dir: str | Path) -> dict[str, Any]:
     that contains (``None`` if none), and ``closest``, the penalty of the smallest larger
     ratio. ``ValueError`` if a trial did not finish or the sweep varies more than penalty and
     seed."""
-    trials = read_sweep(results_dir)
+    trials = read_sweep(results_dir, "RESULTS_DIR")
     by_penalty: dict[float, list[tuple[Point, Point]]] = {}
     references: set[str] = set()
     for trial in trials:

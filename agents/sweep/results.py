@@ -181,21 +181,29 @@ def write_summary(results_dir: str | Path, sweep: dict[str, Any], trials: list[S
     return atomic_write_text(results_dir / SUMMARY_FILE, json.dumps(summary, indent=2) + "\n")
 
 
-def read_summary(results_dir: str | Path) -> dict[str, Any]:
-    """The ``sweep_summary.json`` of the sweep whose results folder is ``results_dir``."""
+def read_summary(results_dir: str | Path, argument: str = "--sweep") -> dict[str, Any]:
+    """The ``sweep_summary.json`` of the sweep whose results folder is ``results_dir``
+    (``ValueError`` naming the command's ``argument`` if it holds none, or not a readable one)."""
     path = Path(results_dir) / SUMMARY_FILE
     if not path.is_file():
         raise ValueError(
-            f"--sweep: {str(results_dir)!r} holds no {SUMMARY_FILE}; give the results_dir of a "
-            f"sweep run with python -m agents.sweep"
+            f"{argument}: {str(results_dir)!r} holds no {SUMMARY_FILE}; give the results_dir "
+            f"of a sweep run with python -m agents.sweep"
         )
-    return json.loads(path.read_text(encoding="utf-8"))
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ValueError(f"{argument}: {path} is not readable JSON ({error})") from None
+    if not isinstance(summary, dict) or not isinstance(summary.get("trials"), list):
+        raise ValueError(f"{argument}: {path} is not a sweep summary (no list of trials)")
+    return summary
 
 
-def read_sweep(results_dir: str | Path) -> list[SweepTrial]:
-    """Every trial of the sweep whose results folder is ``results_dir``, from its summary."""
+def read_sweep(results_dir: str | Path, argument: str = "--sweep") -> list[SweepTrial]:
+    """Every trial of the sweep whose results folder is ``results_dir``, from its summary
+    (errors name the command's ``argument``)."""
     results_dir = Path(results_dir)
-    summary = read_summary(results_dir)
+    summary = read_summary(results_dir, argument)
     return [
         SweepTrial(
             name=entry["name"],
