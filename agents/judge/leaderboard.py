@@ -16,8 +16,8 @@ that makes it:
   (periodic transmission every ``k`` instants, ``k`` matched to it) and **the best
   hand-designed rule** (``models/<EnvName>_hand.json``, a point of the family chosen on
   validation from a menu), all three from ``<EnvName>_hand/``;
-* **per-instant PPO** (``<EnvName>_ppo/``) and **self-triggered PPO** (trained from scratch,
-  where such a run was judged);
+* **per-instant PPO** (``<EnvName>_ppo/``) and the **self-triggered** SB3 learners, PPO and
+  DQN (trained from scratch, where such runs were judged: :attr:`Board.self_triggered`);
 * **learned trigger (ES)** — the searches of ``configs/search/<problem>.yaml``
   (:attr:`Board.learned`);
 * **clairvoyant schedule** — not a trigger: the fewest transmissions at no more than the
@@ -43,7 +43,8 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -69,6 +70,25 @@ SETS = ("test", "paper")
 
 
 @dataclass(frozen=True)
+class LearnerRecord:
+    """One reinforcement-learning row of an id.
+
+    Attributes:
+        folder: the folder of its ``results.json`` (``agents.results`` on the runs judged).
+        what: what the runs are (decisions, seeds, λ and how it was chosen).
+        command: the commands that made the record, where its models are not shipped.
+    """
+
+    folder: str
+    what: str
+    command: str | None = None
+
+
+NOT_TRAINED = "none trained from scratch under the protocol yet"
+"""What a self-triggered row without a record says."""
+
+
+@dataclass(frozen=True)
 class Board:
     """Where one id's rows come from (folders under the records directory).
 
@@ -77,18 +97,14 @@ class Board:
         paper: the paper's number in the suite ("000" .. "004").
         learned: folder of the learned trigger's ``results.json``: the searches of
             ``configs/search/<problem>.yaml``, the configuration the report chose.
-        self_triggered: folder of a self-triggered PPO run trained from scratch, or ``None``.
-        self_triggered_label: what that run is, or why there is none.
-        self_triggered_command: the commands that made that run's record, where its models
-            are not shipped.
+        self_triggered: the self-triggered learners trained from scratch, by row
+            (:data:`SELF_TRIGGERED_TRIGGERS`); a row without one says none was.
     """
 
     env_id: str
     paper: str
     learned: str
-    self_triggered: str | None = None
-    self_triggered_label: str = "none trained from scratch under the protocol yet"
-    self_triggered_command: str | None = None
+    self_triggered: Mapping[str, LearnerRecord] = field(default_factory=dict)
 
     @property
     def name(self) -> str:
@@ -116,17 +132,15 @@ class Board:
         return f"{self.name}_learned_front"
 
 
-def self_triggered_front(env_id: str, problem: str) -> str:
-    """The commands behind a self-triggered PPO row: the front
-    ``configs/sweeps/<problem>_self_triggered_front.yaml`` (penalties × seeds), the penalty
-    chosen on validation, and the judgement of the sweep's groups."""
-    sweep = f"runs/sweeps/{problem}_self_triggered_front"
-    name = env_id.removeprefix("etsc/")
+def self_triggered_front(env_id: str, sweep_name: str, record: str, processes: int = 2) -> str:
+    """The commands behind a self-triggered row: the sweep ``configs/sweeps/<sweep_name>.yaml``
+    (penalties × seeds), the penalty chosen on validation, and the judgement of the sweep's
+    groups into ``docs/results/<record>``."""
+    sweep = f"runs/sweeps/{sweep_name}"
     return (
-        f"python -m agents.sweep --processes 2 --config configs/sweeps/"
-        f"{problem}_self_triggered_front.yaml && python -m agents.judge.penalty_choice {sweep} && "
-        f"python -m agents.results {env_id} --sweep {sweep} "
-        f"--out docs/results/{name}_self_triggered_scratch"
+        f"python -m agents.sweep --processes {processes} --config configs/sweeps/"
+        f"{sweep_name}.yaml && python -m agents.judge.penalty_choice {sweep} && "
+        f"python -m agents.results {env_id} --sweep {sweep} --out docs/results/{record}"
     )
 
 
@@ -138,19 +152,48 @@ BOARDS = (
         "etsc/AttitudeTracking-v0",
         "002",
         "AttitudeTracking-v0_learned_large_budget",
-        "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
-        "holds or eq. (27) × f from scratch, 5 seeds at λ = 300, best-validation checkpoints "
-        "(no λ of 100, 300 contained the paper rule on validation; 300 came closest)",
-        self_triggered_front("etsc/AttitudeTracking-v0", "attitude_tracking"),
+        {
+            "self-triggered PPO": LearnerRecord(
+                "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
+                "holds or eq. (27) × f from scratch, 5 seeds at λ = 300, best-validation "
+                "checkpoints (no λ of 100, 300 contained the paper rule on validation; 300 "
+                "came closest)",
+                self_triggered_front(
+                    "etsc/AttitudeTracking-v0",
+                    "attitude_tracking_self_triggered_front",
+                    "AttitudeTracking-v0_self_triggered_scratch",
+                ),
+            )
+        },
     ),
     Board(
         "etsc/AsteroidOrbitKeeping-v0",
         "003",
         "AsteroidOrbitKeeping-v0_learned",
-        "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
-        "holds or eq. (15) × f from scratch, 5 seeds at λ = 0.3 chosen on validation from 0.3, "
-        "1, 3, 10, best-validation checkpoints",
-        self_triggered_front("etsc/AsteroidOrbitKeeping-v0", "asteroid"),
+        {
+            "self-triggered PPO": LearnerRecord(
+                "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
+                "MaskablePPO: holds or eq. (15) × f from scratch, 5 seeds at λ = 0.3 chosen on "
+                "validation from 0.3, 1, 3, 10, best-validation checkpoints",
+                self_triggered_front(
+                    "etsc/AsteroidOrbitKeeping-v0",
+                    "asteroid_self_triggered_front",
+                    "AsteroidOrbitKeeping-v0_self_triggered_scratch",
+                ),
+            ),
+            "self-triggered DQN": LearnerRecord(
+                "AsteroidOrbitKeeping-v0_self_triggered_dqn/transmission_penalty=0.3",
+                "DQN (semi-Markov target) on the same decisions, unmasked (the shield replaces "
+                "an unsafe hold), 5 seeds at the PPO front's λ = 0.3, best-validation "
+                "checkpoints",
+                self_triggered_front(
+                    "etsc/AsteroidOrbitKeeping-v0",
+                    "asteroid_self_triggered_dqn",
+                    "AsteroidOrbitKeeping-v0_self_triggered_dqn",
+                    processes=1,
+                ),
+            ),
+        },
     ),
     Board("etsc/InnerFormation-v0", "004", "InnerFormation-v0_learned_large_budget"),
 )
@@ -351,12 +394,11 @@ def board_rows(records: Path, board: Board) -> list[Row]:
             hand_command,
         ),
         _results_row(records, f"{board.name}_ppo", "per-instant PPO", PPO_LABEL),
-        _results_row(
-            records,
-            board.self_triggered,
-            "self-triggered PPO",
-            board.self_triggered_label,
-            command=board.self_triggered_command,
+        *(
+            _results_row(records, record.folder, trigger, record.what, command=record.command)
+            if (record := board.self_triggered.get(trigger)) is not None
+            else _results_row(records, None, trigger, NOT_TRAINED)
+            for trigger in SELF_TRIGGERED_TRIGGERS
         ),
         _results_row(
             records,
@@ -450,7 +492,13 @@ def _table(rows: list[Row]) -> list[str]:
     return lines
 
 
-SUMMARY_TRIGGERS = ("always", "clock", HAND, "per-instant PPO", "self-triggered PPO", LEARNED)
+SELF_TRIGGERED_TRIGGERS = ("self-triggered PPO", "self-triggered DQN")
+"""The rows of SB3 learners on self-triggered decisions (:attr:`Board.self_triggered`)."""
+
+RL_TRIGGERS = ("per-instant PPO", *SELF_TRIGGERED_TRIGGERS)
+"""The reinforcement-learning rows, of which the README shows the best."""
+
+SUMMARY_TRIGGERS = ("always", "clock", HAND, *RL_TRIGGERS, LEARNED)
 """The triggers of the across-id summary, each over the ids whose record keeps its test
 episodes."""
 
@@ -525,6 +573,7 @@ ROW_STYLES = {
     HAND: {"marker": "*", "color": "C3", "markersize": 16},
     "per-instant PPO": {"marker": "^", "color": "C4", "markersize": 10},
     "self-triggered PPO": {"marker": "v", "color": "C5", "markersize": 10},
+    "self-triggered DQN": {"marker": "<", "color": "C6", "markersize": 10},
     LEARNED: {"marker": "D", "color": "C2", "markersize": 10},
     ORACLE: {"marker": "P", "color": "k", "markersize": 11},
 }
@@ -721,9 +770,6 @@ def _units(board: Board) -> list[str]:
     ]
 
 
-RL_TRIGGERS = ("per-instant PPO", "self-triggered PPO")
-"""The reinforcement-learning rows, of which the README shows the best."""
-
 README = ROOT / "README.md"
 README_MARKERS = ("<!-- leaderboard: agents.leaderboard writes this table -->", "<!-- end -->")
 """The README's summary table lies between these lines."""
@@ -737,9 +783,11 @@ def best_rl_row(rows: list[Row]) -> Row | None:
     by_name = {row.trigger: row for row in rows}
     paper = by_name["paper's rule"].sets["test"]
     judged = [
-        by_name[name]
-        for name in RL_TRIGGERS
-        if (measure := by_name[name].sets["test"]) is not None and not measure.failures
+        row
+        for row in rows
+        if row.trigger in RL_TRIGGERS
+        and (measure := row.sets["test"]) is not None
+        and not measure.failures
     ]
     if paper is None or not judged:
         return None
