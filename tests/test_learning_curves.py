@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from agents.judge.learning_curves import learning_curves, main, parse_runs
+from agents.judge.learning_curves import learning_curves, main, parse_runs, search_validations
 
 PAPER = {"mean_cost": 1.0, "transmissions": 100.0, "failures": 0}
 
@@ -139,3 +139,27 @@ def test_a_search_is_a_run_against_the_paper_trigger_on_its_validation_scenarios
     assert run["reached_at_env_steps"] == 200
     assert run["points"][0]["cost_ratio"] == pytest.approx(1.01)
     assert result["methods"]["ppo"]["reached"] == "0/1"
+
+    # a committed record keeps the search's curve.json, not its generations
+    (folder / "generations.jsonl").unlink()
+    validation = records[1]["validation"]
+    entry = {
+        "generation": 1,
+        "env_steps": 200,
+        "wall_s": 2.0,
+        "validation_cost": validation["mean_cost"],
+        "validation_transmissions": validation["transmissions"],
+    }
+    for failures in (2, None):  # None: a curve older than its failures key
+        kept = entry if failures is None else {**entry, "validation_failures": failures}
+        (folder / "curve.json").write_text(json.dumps({"search": {}, "curve": [kept]}))
+        (read,) = search_validations(folder)
+        assert read == {
+            "env_steps": 200,
+            "wall_s": 2.0,
+            "mean_cost": validation["mean_cost"],
+            "transmissions": validation["transmissions"],
+            "failures": failures,
+        }
+    (run,) = learning_curves(parse_runs([f"es={folder}"]), 1.05)["methods"]["es"]["runs"]
+    assert run["reached_at_env_steps"] == 200 and run["points"][0]["failures"] is None

@@ -8,8 +8,11 @@ simulated instants and wall-clock time.
 Each ``RUN_DIR`` is the output folder of ``python -m agents.train`` (its ``evaluations.json``:
 the policy and the paper trigger on the validation scenarios, with the sampling instants
 simulated for training so far and the training wall time at every evaluation) or of
-``python -m agents.search`` (its ``generations.jsonl``: the validated mean of the evolution
-strategy, against the paper trigger run once on the same validation scenarios).
+``python -m agents.search`` (its ``generations.jsonl``, or in a committed record its
+``curve.json``: the validated mean of the evolution strategy, against the paper trigger run
+once on the same validation scenarios; a ``curve.json`` older than its ``validation_failures``
+key leaves the mean's failures unknown, and such a run reaches the paper trigger on cost and
+transmissions alone).
 ``--include LEARNING_CURVES_JSON`` keeps the methods of an earlier result (runs whose folders
 are no longer at hand) beside the new runs. Runs with the
 same ``LABEL`` (one method, several training seeds) are drawn in one colour and summarised
@@ -55,11 +58,18 @@ DEFAULT_COST_TOLERANCE = 1.05
 BAND_POINTS = 40
 """Abscissae of a label's interval over seeds."""
 
+LEGEND_PANEL = (1, 0)
+"""The panel whose curves carry the legend's labels: transmissions against instants, which
+every run draws (a cost ratio of 0 draws no band)."""
+ZERO_LINEAR_RANGE = 0.1
+"""Where a ratio reaches 0 its axis is symmetric-log, linear within this range of 0."""
+
 AXES = ("env_steps", "wall_time_s")
 RATIOS = ("cost_ratio", "transmission_ratio")
 
-RUN_RECORDS = ("evaluations.json", "generations.jsonl")
-"""A training run's validation record (``agents.train``) or a search's (``agents.search``)."""
+RUN_RECORDS = ("evaluations.json", "generations.jsonl", "curve.json")
+"""A training run's validation record (``agents.train``) or a search's (``agents.search``: its
+generations, or the curve a committed record keeps of them)."""
 
 
 def parse_runs(specs: list[str]) -> list[tuple[str, Path]]:
@@ -77,11 +87,36 @@ def parse_runs(specs: list[str]) -> list[tuple[str, Path]]:
     return runs
 
 
+def search_validations(folder: Path) -> list[dict[str, Any]]:
+    """The validated mean of each validating generation of the search in ``folder``: from
+    ``generations.jsonl``, else from ``curve.json`` (``failures`` ``None`` where the curve
+    does not keep them); each with its ``env_steps`` and ``wall_s``."""
+    if (folder / "generations.jsonl").is_file():
+        lines = (folder / "generations.jsonl").read_text(encoding="utf-8").splitlines()
+        records = [json.loads(line) for line in lines]
+        return [
+            {"env_steps": r["env_steps"], "wall_s": r["wall_s"], **r["validation"]}
+            for r in records
+            if "validation" in r
+        ]
+    curve = json.loads((folder / "curve.json").read_text(encoding="utf-8"))["curve"]
+    return [
+        {
+            "env_steps": entry["env_steps"],
+            "wall_s": entry["wall_s"],
+            "mean_cost": entry["validation_cost"],
+            "transmissions": entry["validation_transmissions"],
+            "failures": entry.get("validation_failures"),
+        }
+        for entry in curve
+        if "validation_cost" in entry
+    ]
+
+
 def search_evaluations(folder: Path) -> list[dict[str, Any]]:
-    """A search's validation curve (``python -m agents.search``: the validated mean of each
-    validating generation in ``generations.jsonl``) in the form of a training run's
-    ``evaluations.json``, the paper trigger evaluated once on the same validation scenarios
-    (those of the search's ``config.yaml``) as the reference."""
+    """A search's validation curve (:func:`search_validations`) in the form of a training
+    run's ``evaluations.json``, the paper trigger evaluated once on the same validation
+    scenarios (those of the search's ``config.yaml``) as the reference."""
     from agents.search.cma_es import load_config
     from baselines.evaluate import evaluate
 
@@ -94,25 +129,21 @@ def search_evaluations(folder: Path) -> list[dict[str, Any]]:
         set_size=config.validation_size,
     )
     paper = {**evaluated["mean"], "failures": evaluated["aggregates"]["failure"]["count"]}
-    evaluations = []
-    for line in (folder / "generations.jsonl").read_text(encoding="utf-8").splitlines():
-        record = json.loads(line)
-        if "validation" in record:
-            evaluations.append(
-                {
-                    "timesteps": record["env_steps"],
-                    "env_steps": record["env_steps"],
-                    "wall_time_s": record["wall_s"],
-                    "learned": record["validation"],
-                    "paper": paper,
-                }
-            )
-    return evaluations
+    return [
+        {
+            "timesteps": validation["env_steps"],
+            "env_steps": validation["env_steps"],
+            "wall_time_s": validation["wall_s"],
+            "learned": validation,
+            "paper": paper,
+        }
+        for validation in search_validations(folder)
+    ]
 
 
 def run_curve(folder: Path, cost_tolerance: float) -> dict[str, Any]:
     """One run's validation curve relative to the paper trigger, and where it reached it."""
-    if (folder / "generations.jsonl").is_file():
+    if not (folder / "evaluations.json").is_file():
         evaluations = search_evaluations(folder)
     else:
         evaluations = json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
@@ -135,13 +166,14 @@ def run_curve(folder: Path, cost_tolerance: float) -> dict[str, Any]:
                 "failures": learned["failures"],
             }
         )
+    paper_failures = evaluations[0]["paper"]["failures"]
     reached = next(
         (
             point
             for point in points
             if point["cost_ratio"] <= cost_tolerance
             and point["transmission_ratio"] <= 1.0
-            and point["failures"] <= evaluations[0]["paper"]["failures"]
+            and (point["failures"] is None or point["failures"] <= paper_failures)
         ),
         None,
     )
@@ -246,7 +278,7 @@ def plot(result: dict[str, Any], path: Path) -> None:
                         marker="" if bands else ".",
                         label=(
                             f"{label} ({seeds} run{'s' if seeds > 1 else ''})"
-                            if not bands and run_index == 0 and row == column == 0
+                            if not bands and run_index == 0 and (row, column) == LEGEND_PANEL
                             else None
                         ),
                     )
@@ -264,13 +296,28 @@ def plot(result: dict[str, Any], path: Path) -> None:
                     band[y_key]["geometric_mean"],
                     color=colour,
                     linewidth=2.0,
-                    label=f"{label} ({seeds} runs)" if row == column == 0 else None,
+                    label=f"{label} ({seeds} runs)" if (row, column) == LEGEND_PANEL else None,
                 )
-    for row, name in enumerate(("mean_cost / paper", "transmissions / paper")):
-        axes[row, 0].set_ylabel(name)
+    zero = {
+        y_key: any(
+            point[y_key] == 0.0
+            for method in result["methods"].values()
+            for run in method["runs"]
+            for point in run["points"]
+        )
+        for y_key in RATIOS
+    }
+    for row, (y_key, name) in enumerate(
+        zip(RATIOS, ("mean_cost / paper", "transmissions / paper"), strict=True)
+    ):
+        axes[row, 0].set_ylabel(name + (" (symlog: 0 drawn)" if zero[y_key] else ""))
         for column in range(2):
             axes[row, column].axhline(1.0, color="k", linewidth=0.8, linestyle=":")
-            axes[row, column].set_yscale("log")
+            if zero[y_key]:  # a ratio of 0 (003's shell kept: no cost) has no logarithm
+                axes[row, column].set_yscale("symlog", linthresh=ZERO_LINEAR_RANGE)
+                axes[row, column].set_ylim(bottom=-0.1 * ZERO_LINEAR_RANGE)
+            else:
+                axes[row, column].set_yscale("log")
             axes[row, column].grid(True, which="major", alpha=0.3)
     for column in range(2):
         axes[0, column].axhline(result["cost_tolerance"], color="k", linewidth=0.8, linestyle="--")

@@ -628,6 +628,7 @@ def finish(config: SearchConfig, out: Path, history: list[dict[str, Any]]) -> Le
                     "validation_return": record["validation"]["return"],
                     "validation_cost": record["validation"]["mean_cost"],
                     "validation_transmissions": record["validation"]["transmissions"],
+                    "validation_failures": record["validation"]["failures"],
                 }
                 if "validation" in record
                 else {}
