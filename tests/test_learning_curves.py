@@ -163,3 +163,21 @@ def test_a_search_is_a_run_against_the_paper_trigger_on_its_validation_scenarios
         }
     (run,) = learning_curves(parse_runs([f"es={folder}"]), 1.05)["methods"]["es"]["runs"]
     assert run["reached_at_env_steps"] == 200 and run["points"][0]["failures"] is None
+
+
+def test_an_out_folder_holding_other_runs_is_refused(tmp_path: Path, capsys) -> None:
+    """The same runs are drawn again in place (also as an included result with a new run
+    of the same label, whose summary is recomputed); other runs need their own --out."""
+    first = _run(tmp_path / "first", [(1.2, 50.0, 0)], 1)
+    second = _run(tmp_path / "second", [(1.0, 50.0, 0)], 1)
+    out = tmp_path / "out"
+    assert main(["--run", f"ppo={first}", "--out", str(out)]) == 0
+    assert main(["--run", f"ppo={first}", "--out", str(out)]) == 0
+    with pytest.raises(SystemExit):
+        main(["--run", f"ppo={second}", "--out", str(out)])
+    assert f"--out {out} holds the learning curves of 1 other runs (ppo)" in capsys.readouterr().err
+    grown = tmp_path / "grown"
+    included = ["--include", str(out / "learning_curves.json")]
+    assert main([*included, "--run", f"ppo={second}", "--out", str(grown)]) == 0
+    result = json.loads((grown / "learning_curves.json").read_text(encoding="utf-8"))
+    assert result["methods"]["ppo"]["reached"] == "1/2"

@@ -48,6 +48,7 @@ import numpy as np
 
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
+from etsc_envs.core.json_files import read_json_file, require_mapping
 from etsc_envs.evaluation.arguments import write_json
 from etsc_envs.evaluation.statistics import summarize
 
@@ -247,8 +248,6 @@ def learning_curves(
         methods.setdefault(label, {"runs": []})["runs"].append(run_curve(folder, cost_tolerance))
     for method in methods.values():
         method["bands"] = seed_bands(method["runs"])
-        if "reached" in method:
-            continue
         reached = [run for run in method["runs"] if run["reached_at_env_steps"] is not None]
         method["reached"] = f"{len(reached)}/{len(method['runs'])}"
         method["env_steps_to_reach"] = _spread([run["reached_at_env_steps"] for run in reached])
@@ -335,6 +334,31 @@ def plot(result: dict[str, Any], path: Path) -> None:
     save(figure, path)
 
 
+def curve_runs(result: dict[str, Any]) -> set[tuple[str, str]]:
+    """The (label, run folder) of every run of a ``learning_curves.json``."""
+    return {
+        (label, str(run["run"]))
+        for label, method in result["methods"].items()
+        for run in method["runs"]
+    }
+
+
+def require_own_curves(out_dir: Path, runs: list[tuple[str, Path]], earlier: list[dict]) -> None:
+    """``ValueError`` before any work when ``out_dir`` holds the ``learning_curves.json`` of
+    other runs: the same runs are drawn again in place, another comparison gets its own
+    folder."""
+    path = out_dir / "learning_curves.json"
+    if not path.exists():
+        return
+    held = curve_runs(require_mapping(read_json_file(path, f"--out {path}"), ""))
+    mine = {(label, str(folder)) for label, folder in runs}.union(*map(curve_runs, earlier))
+    if held != mine:
+        raise ValueError(
+            f"--out {out_dir} holds the learning curves of {len(held)} other runs "
+            f"({', '.join(sorted({label for label, _ in held}))}); give these runs their own --out"
+        )
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m agents.judge.learning_curves",
@@ -358,6 +382,7 @@ def main(argv: list[str] | None = None) -> int:
         require_writable_folder(out_dir, "--out")
         earlier = [json.loads(path.read_text(encoding="utf-8")) for path in args.include]
         runs = parse_runs(args.run) if args.run or not earlier else []
+        require_own_curves(out_dir, runs, earlier)
         result = learning_curves(runs, args.cost_tolerance, earlier)
     except (ValueError, OSError, KeyError) as error:
         parser.error(str(error))
