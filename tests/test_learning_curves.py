@@ -181,3 +181,45 @@ def test_an_out_folder_holding_other_runs_is_refused(tmp_path: Path, capsys) -> 
     assert main([*included, "--run", f"ppo={second}", "--out", str(grown)]) == 0
     result = json.loads((grown / "learning_curves.json").read_text(encoding="utf-8"))
     assert result["methods"]["ppo"]["reached"] == "1/2"
+
+
+def test_searches_of_one_configuration_share_one_paper_evaluation(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The paper trigger is evaluated once per configuration, not once per search folder."""
+    import baselines.evaluate
+    from agents.judge.learning_curves import paper_validation
+
+    calls = []
+
+    def counted(env_id: str, policy: str, **kwargs: object) -> dict:
+        calls.append((env_id, policy, kwargs))
+        return {
+            "mean": {"mean_cost": 1.0, "transmissions": 10.0},
+            "aggregates": {"failure": {"count": 0}},
+        }
+
+    monkeypatch.setattr(baselines.evaluate, "evaluate", counted)
+    paper_validation.cache_clear()
+    curve = {
+        "generation": 1,
+        "env_steps": 200,
+        "wall_s": 2.0,
+        "validation_cost": 0.5,
+        "validation_transmissions": 5.0,
+        "validation_failures": 0,
+    }
+    specs = []
+    for name, validation_size in (("a", 2), ("b", 2), ("c", 3)):
+        folder = tmp_path / name
+        folder.mkdir()
+        (folder / "config.yaml").write_text(
+            "env_id: etsc/InnerFormation-v0\npenalty: 5.0\nsearch: [factors]\ngenerations: 2\n"
+            f"population: 2\nscenarios: 1\nvalidation_size: {validation_size}\n"
+        )
+        (folder / "curve.json").write_text(json.dumps({"search": {}, "curve": [curve]}))
+        specs.append(f"es={folder}")
+    runs = learning_curves(parse_runs(specs), 1.05)["methods"]["es"]["runs"]
+    paper_validation.cache_clear()
+    assert [run["points"][0]["cost_ratio"] for run in runs] == [0.5, 0.5, 0.5]
+    assert [kwargs["set_size"] for _, _, kwargs in calls] == [2, 3]

@@ -39,6 +39,7 @@ the paper trigger against instants and against seconds) into ``DIR`` (default
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 from pathlib import Path
 from typing import Any
@@ -114,22 +115,35 @@ def search_validations(folder: Path) -> list[dict[str, Any]]:
     ]
 
 
+@functools.cache
+def paper_validation(env_id: str, env_args_json: str, set_size: int) -> dict[str, Any]:
+    """The paper trigger's means (and failure count) on the first ``set_size`` validation
+    scenarios of ``env_id`` with the env args of ``env_args_json``, evaluated once per call of
+    the command: the searches of one configuration share it."""
+    from baselines.evaluate import evaluate
+
+    evaluated = evaluate(
+        env_id,
+        "paper",
+        env_args=json.loads(env_args_json),
+        scenarios="validation",
+        set_size=set_size,
+    )
+    return {**evaluated["mean"], "failures": evaluated["aggregates"]["failure"]["count"]}
+
+
 def search_evaluations(folder: Path) -> list[dict[str, Any]]:
     """A search's validation curve (:func:`search_validations`) in the form of a training
     run's ``evaluations.json``, the paper trigger evaluated once on the same validation
     scenarios (those of the search's ``config.yaml``) as the reference."""
     from agents.search.cma_es import load_config
-    from baselines.evaluate import evaluate
 
     config = load_config(folder / "config.yaml")
-    evaluated = evaluate(
+    paper = paper_validation(
         config.env_id,
-        "paper",
-        env_args=config.env_args(training=False),
-        scenarios="validation",
-        set_size=config.validation_size,
+        json.dumps(config.env_args(training=False), sort_keys=True),
+        config.validation_size,
     )
-    paper = {**evaluated["mean"], "failures": evaluated["aggregates"]["failure"]["count"]}
     return [
         {
             "timesteps": validation["env_steps"],
