@@ -57,7 +57,11 @@ def test_rows_read_the_records_they_name() -> None:
     assert clock.sent["mean"] == pytest.approx(hand.sent["mean"], rel=0.02)
     assert rows["always"].sets["test"].sent["mean"] == 50_000
     learned = rows[leaderboard.LEARNED]
-    assert learned.sets["test"] is not None and learned.sets["test"].episodes == 5 * 64
+    seeds = json.loads(
+        (leaderboard.RECORDS / BOARD.learned / "results.json").read_text(encoding="utf-8")
+    )["models"]
+    assert len(seeds) >= 5 and f"({len(seeds)} search seeds" in learned.what
+    assert learned.sets["test"] is not None and learned.sets["test"].episodes == len(seeds) * 64
 
 
 @pytest.mark.parametrize("board", leaderboard.BOARDS, ids=lambda board: board.name)

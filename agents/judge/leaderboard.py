@@ -153,7 +153,7 @@ BOARDS = (
     Board(
         "etsc/AttitudeTracking-v0",
         "002",
-        "AttitudeTracking-v0_learned_large_budget",
+        "AttitudeTracking-v0_learned_wide_exponent",
         {
             "self-triggered PPO": LearnerRecord(
                 "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
