@@ -198,7 +198,26 @@ BOARDS = (
             ),
         },
     ),
-    Board("etsc/InnerFormation-v0", "004", "InnerFormation-v0_learned_large_budget"),
+    Board(
+        "etsc/InnerFormation-v0",
+        "004",
+        "InnerFormation-v0_learned_large_budget",
+        {
+            "self-triggered PPO": LearnerRecord(
+                None,
+                "MaskablePPO: holds or eqs. (4)–(6) × f from scratch, 5 seeds at λ = 5 (200 000 "
+                "decisions, 2.3–2.4 M instants each), best-validation checkpoints: on validation "
+                "(16 scenarios of 20 s) ×0.94–2.7 the paper rule's transmissions at ×1.000–1.004 "
+                "its cost, the seeds' mean not containing the rule; not judged on the test set "
+                "yet (about 2 CPU-hours of one-decision-at-a-time episodes)",
+                self_triggered_front(
+                    "etsc/InnerFormation-v0",
+                    "inner_formation_self_triggered_front",
+                    "InnerFormation-v0_self_triggered_scratch",
+                ),
+            )
+        },
+    ),
 )
 """Every id's rows, in the papers' order."""
 
