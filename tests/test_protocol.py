@@ -18,6 +18,7 @@ from etsc_envs.evaluation.statistics import (
     seeds_summary,
     summarize,
 )
+from etsc_envs.evaluation.verdict import Axis
 from etsc_envs.protocol import (
     DEFAULT_SET_SIZE,
     TEST_SEEDS,
@@ -146,6 +147,22 @@ def test_several_seeds_aggregate_with_the_stratified_bootstrap() -> None:
     assert result["runs"] == 3 and result["per_run"] == pytest.approx([0.9, 1.0, 1.1])
     assert result["range"] == pytest.approx([0.9, 1.1])
     assert result["iqm_ci95"][0] <= result["iqm"] <= result["iqm_ci95"][1]
+
+
+def test_seeds_worse_than_a_zero_reference_everywhere_have_no_ratio() -> None:
+    """Seeds above a reference that is 0 on every scenario (a method that fails the paper
+    scenario its rule keeps at cost 0) get no ratio and count as worse there, as one seed does
+    with :func:`paired_ratio`, instead of stopping the judgement."""
+    pytest.importorskip("rliable")
+    runs = np.array([[2.0], [3.0], [0.5]])
+    result = seeds_ratio(runs, np.zeros(1))
+    single = paired_ratio(runs[0], np.zeros(1))
+    assert result["iqm"] is None is single["iqm"] and result["iqm_ci95"] is None
+    assert result["range"] is None and result["per_run"] == [None, None, None]
+    assert result["worse_where_reference_zero"] == single["worse_where_reference_zero"] == 1
+    assert Axis(result["iqm_ci95"], 1.0, result["worse_where_reference_zero"]).outcome()[0] == (
+        "loses"
+    )
 
 
 def test_stratified_intervals_are_the_same_in_every_call() -> None:

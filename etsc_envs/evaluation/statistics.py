@@ -199,7 +199,9 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
     stratified bootstrap interval over scenarios and runs (``iqm``, ``iqm_ci95``), each run's
     own IQM (``per_run``) and their range. Zero references follow :func:`paired_ratio`: 0 / 0
     is 1, and a scenario where a run is above a zero reference leaves the ratios and is counted
-    in ``worse_where_reference_zero``.
+    in ``worse_where_reference_zero``; where that leaves no scenario (e.g. a method that fails
+    the one paper scenario its reference keeps at cost 0), ``iqm``, ``iqm_ci95``, each run's
+    IQM and ``range`` are ``None``.
     """
     from rliable import metrics
 
@@ -207,7 +209,15 @@ def seeds_ratio(candidate: np.ndarray, reference: np.ndarray) -> dict[str, Any]:
     b = np.broadcast_to(np.asarray(reference, dtype=float), a.shape)
     worse = np.any((b == 0.0) & (a != 0.0), axis=0)
     if worse.all():
-        raise ValueError("no scenario has a ratio: the reference is 0 wherever a run is not")
+        return {
+            "runs": int(a.shape[0]),
+            "n": int(a.shape[1]),
+            "iqm": None,
+            "iqm_ci95": None,
+            "per_run": [None] * int(a.shape[0]),
+            "range": None,
+            "worse_where_reference_zero": int(worse.sum()),
+        }
     kept_a, kept_b = a[:, ~worse], b[:, ~worse]
     ratios = np.where(kept_b == 0.0, 1.0, kept_a / np.where(kept_b == 0.0, 1.0, kept_b))
     point, interval = _stratified_bootstrap(
