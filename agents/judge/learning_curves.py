@@ -118,8 +118,8 @@ def search_validations(folder: Path) -> list[dict[str, Any]]:
 @functools.cache
 def paper_validation(env_id: str, env_args_json: str, set_size: int) -> dict[str, Any]:
     """The paper trigger's means (and failure count) on the first ``set_size`` validation
-    scenarios of ``env_id`` with the env args of ``env_args_json``, evaluated once per call of
-    the command: the searches of one configuration share it."""
+    scenarios of ``env_id`` with the env args of ``env_args_json``, evaluated once per process
+    (the evaluation is deterministic): the searches of one configuration share it."""
     from baselines.evaluate import evaluate
 
     evaluated = evaluate(
