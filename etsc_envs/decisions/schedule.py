@@ -79,6 +79,23 @@ class IntervalSchedule:
             if decisions.shield_multiple is None or shield is None
             else shield(observation_names, sampling_period_s, decisions.shield_multiple)
         )
+        self.rules_allowed = (
+            np.ones(len(self.rules), dtype=bool)
+            if self.shield is None
+            else self.shield.allowed_factors(self._rule_factors())
+        )
+        """Whether each trigger action's scaled rule is safe: a property of the set, not of
+        the observation, so it is computed once (its thresholds come from the paper's design)."""
+
+    def _rule_factors(self) -> np.ndarray:
+        """Each trigger action's common threshold factor (NaN where it has none)."""
+        factors = []
+        for index in self.rules:
+            action = self.decisions.actions[index]
+            assert isinstance(action, TriggerAction)
+            factor = action.factor(self.decisions.env_id)
+            factors.append(np.nan if factor is None else factor)
+        return np.array(factors, dtype=float)
 
     def masks(self, obs: np.ndarray) -> np.ndarray:
         """Allowed actions at decision instants with observations ``obs``: ``(batch, n)``."""
@@ -87,12 +104,7 @@ class IntervalSchedule:
         if self.shield is None:
             return allowed
         allowed[:, self.holds] = self.shield.allowed_holds(obs, self.lengths[self.holds])
-        factors = []
-        for index in self.rules:
-            action = self.decisions.actions[index]
-            assert isinstance(action, TriggerAction)
-            factors.append(action.factor(self.decisions.env_id))
-        allowed[:, self.rules] = self.shield.allowed_factors(np.array(factors, dtype=float))
+        allowed[:, self.rules] = self.rules_allowed
         return allowed
 
     def shielded(self, actions: np.ndarray, obs: np.ndarray) -> np.ndarray:
