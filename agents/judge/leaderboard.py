@@ -74,14 +74,12 @@ class LearnerRecord:
     """One reinforcement-learning row of an id.
 
     Attributes:
-        folder: the folder of its ``results.json`` (``agents.results`` on the runs judged), or
-            ``None`` while its runs have not all finished.
-        what: what the runs are (decisions, seeds, λ and how it was chosen), or how far they
-            got.
+        folder: the folder of its ``results.json`` (``agents.results`` on the runs judged).
+        what: what the runs are (decisions, seeds, λ and how it was chosen).
         command: the commands that make the record, where its models are not shipped.
     """
 
-    folder: str | None
+    folder: str
     what: str
     command: str | None = None
 
@@ -204,12 +202,11 @@ BOARDS = (
         "InnerFormation-v0_learned_large_budget",
         {
             "self-triggered PPO": LearnerRecord(
-                None,
+                "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
                 "MaskablePPO: holds or eqs. (4)–(6) × f from scratch, 5 seeds at λ = 5 (200 000 "
-                "decisions, 2.3–2.4 M instants each), best-validation checkpoints: on validation "
-                "(16 scenarios of 20 s) ×0.94–2.7 the paper rule's transmissions at ×1.000–1.004 "
-                "its cost, the seeds' mean not containing the rule; not judged on the test set "
-                "yet (about 2 CPU-hours of one-decision-at-a-time episodes)",
+                "decisions, 2.3–2.4 M instants of 20-s episodes each), best-validation "
+                "checkpoints (λ = 5 does not contain the paper rule on validation; λ = 2 was "
+                "stopped at 50 000 decisions, ×7.7–13 the rule's transmissions)",
                 self_triggered_front(
                     "etsc/InnerFormation-v0",
                     "inner_formation_self_triggered_front",
