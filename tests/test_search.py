@@ -186,6 +186,10 @@ def test_training_seeds_avoid_the_protocols_sets() -> None:
         ({"penalty": float("inf")}, "penalty"),
         ({"horizon_s": 0}, "horizon_s"),
         ({"search": ["modulation"]}, "inputs"),
+        (
+            {"env_id": "etsc/ClusterContainment-v0", "start": {}, "search": ["modulation"]},
+            "cannot be searched on etsc/ClusterContainment-v0",
+        ),
         ({"colour": "red"}, "unknown keys"),
         ({"start": {"factors": {"psi": 0.0}}}, "factors.psi"),
         ({"exponent_range": [2.0, 1.0]}, r"search.exponent_range' must be \[low, high\]"),

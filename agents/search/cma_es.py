@@ -225,6 +225,12 @@ def _checked_config(raw: dict[str, Any]) -> SearchConfig:
             "key 'search.start.coupling' gives the coupling a search of coupling starts from "
             "(e.g. {weights: [1, 1, 1], strength: 0} on 004's three axes)"
         )
+    if "modulation" in search and env_id in etsc_envs.PETTINGZOO_ENV_IDS:
+        raise ValueError(
+            f"key 'search.search': the network ('modulation') cannot be searched on {env_id}: "
+            "the family kernel reads one set of inputs for every channel, where each agent would "
+            "need its own follower's; search its central id instead"
+        )
     if ("modulation" in search) != bool(inputs):
         raise ValueError(
             "key 'search.inputs' names the observations the network reads: needed by a search "
