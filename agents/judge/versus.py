@@ -27,13 +27,13 @@ as ``models/<id>_learned.json``); it may be left out where the reference judged 
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from etsc_envs.core.files import output_file_argument
+from etsc_envs.core.json_files import read_json_file
 from etsc_envs.evaluation.arguments import write_json
 from etsc_envs.evaluation.statistics import seeds_ratio
 from etsc_envs.evaluation.verdict import compare, ratio_axis
@@ -51,8 +51,8 @@ def load_record(path: str | Path, argument: str) -> tuple[Path, dict[str, Any]]:
     path = Path(path)
     file = path / "results.json" if path.is_dir() else path
     try:
-        record = json.loads(file.read_text())
-    except (OSError, json.JSONDecodeError) as error:
+        record = read_json_file(file)
+    except ValueError as error:
         raise ValueError(
             f"{argument}: no readable results.json at {str(path)!r} ({error})"
         ) from None
@@ -96,11 +96,6 @@ def _bytes(path: str) -> bytes | None:
         return None
 
 
-def _episodes(judged: dict[str, Any], index: int) -> list[dict[str, Any]]:
-    """The episode records of model ``index`` of a judged set."""
-    return judged["models"][index]["learned"]["episodes"]
-
-
 def compare_records(
     candidate: dict[str, Any], reference: dict[str, Any], index: int
 ) -> dict[str, dict[str, Any]]:
@@ -120,8 +115,8 @@ def compare_records(
     sets = {}
     for name in names:
         ours, theirs = candidate["sets"][name], reference["sets"][name]
-        runs = [_episodes(ours, i) for i in range(len(ours["models"]))]
-        base = _episodes(theirs, index)
+        runs = [model["learned"]["episodes"] for model in ours["models"]]
+        base = theirs["models"][index]["learned"]["episodes"]
         seeds = [episode["seed"] for episode in base]
         if any([episode["seed"] for episode in run] != seeds for run in runs):
             raise ValueError(f"the records ran different scenarios on the {name} set")
