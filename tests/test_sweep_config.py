@@ -140,9 +140,13 @@ def test_a_search_may_use_asha_and_optuna_with_an_objective(tmp_path: Path) -> N
         sweep_config_from_dict(sweep(tmp_path, kind="search", search=bad))
 
 
-SHIPPED_FRONTS = sorted(
+SHIPPED_SWEEPS = sorted(
     path for path in (ROOT / "configs" / "sweeps").glob("*.yaml") if path.name != "tiny.yaml"
 )
+SHIPPED_FRONTS = [
+    path for path in SHIPPED_SWEEPS if yaml.safe_load(path.read_text())["kind"] == "front"
+]
+SHIPPED_TUNINGS = [path for path in SHIPPED_SWEEPS if path not in SHIPPED_FRONTS]
 
 
 def _penalties(config: SweepConfig) -> list[float]:
@@ -168,6 +172,21 @@ def test_a_shipped_front_crosses_penalties_with_three_seeds(path: Path) -> None:
     assert len(_penalties(config)) >= 2
     assert len(config.grid["seed"]) >= 3
     assert Path(config.results_dir).parts[-3:-1] == ("runs", "sweeps")
+
+
+@pytest.mark.parametrize("path", SHIPPED_TUNINGS, ids=lambda path: path.stem)
+def test_a_shipped_tuning_maximises_the_kept_checkpoints_validation_return(path: Path) -> None:
+    """A shipped hyperparameter search scores each trial on the validation set alone, by the
+    return of the checkpoint the run keeps, with Optuna drawing the values; the front that
+    trains with the tuned values shares its base config."""
+    config = load_sweep_config(path)
+    assert (config.kind, config.search_algorithm) == ("search", "optuna")
+    assert (config.metric, config.mode) == ("best_validation_return", "max")
+    assert config.search and config.num_samples >= 8
+    assert config.trial_mapping({}, Path("trial"))["evaluation_every"] > 0
+    front = path.with_name(path.name.replace("_tuning", "_front"))
+    assert front in SHIPPED_FRONTS
+    assert yaml.safe_load(front.read_text())["base"] == yaml.safe_load(path.read_text())["base"]
 
 
 def test_the_shipped_fronts_are_of_the_suites_ids() -> None:

@@ -28,23 +28,36 @@ from agents.train.vector_adapter import make_sb3_vec_env
 ENV_ID = "etsc/AttitudeTracking-v0"
 
 
-def evaluation(learned_cost: float, learned_sent: int, paper_cost: float, paper_sent: int):
+def evaluation(
+    learned_cost: float, learned_sent: int, paper_cost: float, paper_sent: int, learned_return=-1.0
+):
     return {
         "timesteps": 1024,
-        "learned": {"mean_cost": learned_cost, "transmissions": learned_sent, "failure": None},
+        "learned": {
+            "mean_cost": learned_cost,
+            "transmissions": learned_sent,
+            "return": learned_return,
+            "failure": None,
+        },
         "paper": {"mean_cost": paper_cost, "transmissions": paper_sent, "failure": None},
     }
 
 
 def test_scores_compare_the_last_evaluation_with_the_paper_trigger() -> None:
-    reported = scores(2048, -3.5, evaluation(1.1, 30, 1.0, 120))
+    reported = scores(2048, -3.5, [evaluation(9.0, 99, 1.0, 120), evaluation(1.1, 30, 1.0, 120)])
     assert reported["timesteps"] == 2048 and reported["training_reward"] == -3.5
     assert reported["cost_ratio"] == pytest.approx(1.1)
     assert reported["transmission_ratio"] == pytest.approx(0.25)
     assert reported["paper_transmissions"] == 120
-    no_paper_cost = scores(2048, None, evaluation(0.5, 30, 0.0, 120))
+    no_paper_cost = scores(2048, None, [evaluation(0.5, 30, 0.0, 120)])
     assert "cost_ratio" not in no_paper_cost and "training_reward" not in no_paper_cost
-    assert scores(10, None, None) == {"timesteps": 10}
+    assert scores(10, None, []) == {"timesteps": 10}
+
+
+def test_the_best_validation_return_is_the_kept_checkpoints_not_the_last() -> None:
+    history = [evaluation(1.0, 30, 1.0, 120, learned_return=r) for r in (-9.0, -2.0, -5.0)]
+    assert scores(3072, None, history)["best_validation_return"] == -2.0
+    assert scores(1024, None, history[:1])["best_validation_return"] == -9.0
 
 
 def make_sweep(results_dir: Path) -> None:

@@ -16,8 +16,9 @@ that makes it:
   (periodic transmission every ``k`` instants, ``k`` matched to it) and **the best
   hand-designed rule** (``models/<EnvName>_hand.json``, a point of the family chosen on
   validation from a menu), all three from ``<EnvName>_hand/``;
-* **per-instant PPO** (``<EnvName>_ppo/``) and the **self-triggered** SB3 learners, PPO and
-  DQN (trained from scratch, where such runs were judged: :attr:`Board.self_triggered`);
+* the SB3 learners: **per-instant PPO** and, on self-triggered decisions, **PPO** and **DQN**
+  (trained from scratch under the protocol, where such runs were judged: :attr:`Board.learners`;
+  per-instant PPO otherwise from its pre-protocol record ``<EnvName>_ppo/``);
 * **learned trigger (ES)** — the searches of ``configs/search/<problem>.yaml``
   (:attr:`Board.learned`);
 * **clairvoyant schedule** — not a trigger: the fewest transmissions at no more than the
@@ -85,7 +86,7 @@ class LearnerRecord:
 
 
 NOT_TRAINED = "none trained from scratch under the protocol yet"
-"""What a self-triggered row without a record says."""
+"""What a self-triggered learner's row without a record says."""
 
 
 @dataclass(frozen=True)
@@ -97,14 +98,15 @@ class Board:
         paper: the paper's number in the suite ("000" .. "004").
         learned: folder of the learned trigger's ``results.json``: the searches of
             ``configs/search/<problem>.yaml``, the configuration the report chose.
-        self_triggered: the self-triggered learners trained from scratch, by row
-            (:data:`SELF_TRIGGERED_TRIGGERS`); a row without one says none was.
+        learners: the SB3 learners trained from scratch under the protocol, by row
+            (:data:`RL_TRIGGERS`); per-instant PPO without one is its pre-protocol record,
+            a self-triggered row without one says none was trained.
     """
 
     env_id: str
     paper: str
     learned: str
-    self_triggered: Mapping[str, LearnerRecord] = field(default_factory=dict)
+    learners: Mapping[str, LearnerRecord] = field(default_factory=dict)
 
     @property
     def name(self) -> str:
@@ -132,8 +134,8 @@ class Board:
         return f"{self.name}_learned_front"
 
 
-def self_triggered_front(env_id: str, sweep_name: str, record: str, processes: int = 2) -> str:
-    """The commands behind a self-triggered row: the sweep ``configs/sweeps/<sweep_name>.yaml``
+def learner_front(env_id: str, sweep_name: str, record: str, processes: int = 2) -> str:
+    """The commands behind an SB3 learner's row: the sweep ``configs/sweeps/<sweep_name>.yaml``
     (penalties × seeds), the penalty chosen on validation, and the judgement of the sweep's
     groups into ``docs/results/<record>``."""
     sweep = f"runs/sweeps/{sweep_name}"
@@ -158,7 +160,7 @@ BOARDS = (
                 "holds or eq. (27) × f from scratch, 5 seeds at λ = 300, best-validation "
                 "checkpoints (no λ of 100, 300 contained the paper rule on validation; 300 "
                 "came closest)",
-                self_triggered_front(
+                learner_front(
                     "etsc/AttitudeTracking-v0",
                     "attitude_tracking_self_triggered_front",
                     "AttitudeTracking-v0_self_triggered_scratch",
@@ -175,7 +177,7 @@ BOARDS = (
                 "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
                 "MaskablePPO: holds or eq. (15) × f from scratch, 5 seeds at λ = 0.3 chosen on "
                 "validation from 0.3, 1, 3, 10, best-validation checkpoints",
-                self_triggered_front(
+                learner_front(
                     "etsc/AsteroidOrbitKeeping-v0",
                     "asteroid_self_triggered_front",
                     "AsteroidOrbitKeeping-v0_self_triggered_scratch",
@@ -187,7 +189,7 @@ BOARDS = (
                 "an unsafe hold), 5 seeds at the PPO front's λ = 0.3, best-validation "
                 "checkpoints (λ does not contain the paper rule on validation: every seed "
                 "leaves the region or collides on most scenarios)",
-                self_triggered_front(
+                learner_front(
                     "etsc/AsteroidOrbitKeeping-v0",
                     "asteroid_self_triggered_dqn",
                     "AsteroidOrbitKeeping-v0_self_triggered_dqn",
@@ -207,7 +209,7 @@ BOARDS = (
                 "decisions, 2.3–2.4 M instants of 20-s episodes each), best-validation "
                 "checkpoints (λ = 5 does not contain the paper rule on validation; λ = 2 was "
                 "stopped at 50 000 decisions, ×7.7–13 the rule's transmissions)",
-                self_triggered_front(
+                learner_front(
                     "etsc/InnerFormation-v0",
                     "inner_formation_self_triggered_front",
                     "InnerFormation-v0_self_triggered_scratch",
@@ -224,7 +226,8 @@ SHORT_NAMES = {
 }
 """Each id as the across-id table names it: its paper, and which form of paper 001."""
 
-PPO_LABEL = "one seed, trained before the protocol (checkpoint chosen on the paper scenario)"
+PRE_PROTOCOL_PPO = "one seed, trained before the protocol (checkpoint chosen on the paper scenario)"
+"""What the per-instant PPO row says where no protocol runs were judged."""
 
 
 @dataclass
@@ -412,12 +415,13 @@ def board_rows(records: Path, board: Board) -> list[Row]:
             {name: _record_measure(hand, name, "learned") for name in SETS},
             hand_command,
         ),
-        _results_row(records, f"{board.name}_ppo", "per-instant PPO", PPO_LABEL),
         *(
             _results_row(records, record.folder, trigger, record.what, command=record.command)
-            if (record := board.self_triggered.get(trigger)) is not None
+            if (record := board.learners.get(trigger)) is not None
+            else _results_row(records, f"{board.name}_ppo", trigger, PRE_PROTOCOL_PPO)
+            if trigger == PER_INSTANT_PPO
             else _results_row(records, None, trigger, NOT_TRAINED)
-            for trigger in SELF_TRIGGERED_TRIGGERS
+            for trigger in RL_TRIGGERS
         ),
         _results_row(
             records,
@@ -511,10 +515,9 @@ def _table(rows: list[Row]) -> list[str]:
     return lines
 
 
-SELF_TRIGGERED_TRIGGERS = ("self-triggered PPO", "self-triggered DQN")
-"""The rows of SB3 learners on self-triggered decisions (:attr:`Board.self_triggered`)."""
-
-RL_TRIGGERS = ("per-instant PPO", *SELF_TRIGGERED_TRIGGERS)
+PER_INSTANT_PPO = "per-instant PPO"
+RL_TRIGGERS = (PER_INSTANT_PPO, "self-triggered PPO", "self-triggered DQN")
+"""The rows of the SB3 learners (:attr:`Board.learners`)."""
 """The reinforcement-learning rows, of which the README shows the best."""
 
 SUMMARY_TRIGGERS = ("always", "clock", HAND, *RL_TRIGGERS, LEARNED)

@@ -49,44 +49,49 @@ METRICS = (
     "paper_transmissions",
     "cost_ratio",
     "transmission_ratio",
+    "best_validation_return",
 )
-"""What a trial reports to Tune (the last four once the training callback has evaluated):
-training steps, the mean return of the last training episodes, the last evaluation's
-``mean_cost`` and transmissions of the learned policy and of the paper trigger, and their
-ratios learned / paper (absent where the paper's value is 0)."""
+"""What a trial reports to Tune (all but the first two once the training callback has
+evaluated): training steps, the mean return of the last training episodes, the last
+evaluation's ``mean_cost`` and transmissions of the learned policy and of the paper trigger,
+their ratios learned / paper (absent where the paper's value is 0), and the highest mean
+validation return of the evaluations so far — the score of the checkpoint the run keeps
+(``best_model.zip``), which a hyperparameter search maximises."""
 
 EVALUATION_METRICS = METRICS[2:]
 """The metrics that come from the training run's evaluations against the paper trigger."""
 
 
 def scores(
-    timesteps: int, training_reward: float | None, evaluation: dict[str, Any] | None
+    timesteps: int, training_reward: float | None, evaluations: list[dict[str, Any]]
 ) -> dict[str, Any]:
     """The reported metrics (:data:`METRICS`) from the training steps, the mean training
-    return (``None`` before an episode ended) and the last entry of ``evaluations.json``
-    (``None`` before the first)."""
+    return (``None`` before an episode ended) and the entries of ``evaluations.json`` so far
+    (none before the first evaluation)."""
     result: dict[str, Any] = {"timesteps": int(timesteps)}
     if training_reward is not None:
         result["training_reward"] = float(training_reward)
-    if evaluation is None:
+    if not evaluations:
         return result
-    learned, paper = evaluation["learned"], evaluation["paper"]
+    learned, paper = evaluations[-1]["learned"], evaluations[-1]["paper"]
     for name, summary in (("learned", learned), ("paper", paper)):
         result[f"{name}_mean_cost"] = summary["mean_cost"]
         result[f"{name}_transmissions"] = summary["transmissions"]
     for ratio, key in (("cost_ratio", "mean_cost"), ("transmission_ratio", "transmissions")):
         if paper[key]:
             result[ratio] = learned[key] / paper[key]
+    result["best_validation_return"] = max(
+        float(evaluation["learned"]["return"]) for evaluation in evaluations
+    )
     return result
 
 
-def last_evaluation(folder: str | Path) -> dict[str, Any] | None:
-    """The last entry of a training run's ``evaluations.json``, or ``None`` if it has none."""
+def evaluations_so_far(folder: str | Path) -> list[dict[str, Any]]:
+    """The entries of a training run's ``evaluations.json`` (none if it has not evaluated)."""
     path = Path(folder) / EVALUATIONS_FILE
     if not path.is_file():
-        return None
-    evaluations = json.loads(path.read_text(encoding="utf-8"))
-    return evaluations[-1] if evaluations else None
+        return []
+    return json.loads(path.read_text(encoding="utf-8"))
 
 
 def final_scores(folder: str | Path) -> dict[str, Any] | None:
@@ -114,7 +119,7 @@ def final_scores(folder: str | Path) -> dict[str, Any] | None:
     summary = json.loads(summary_path.read_text(encoding="utf-8"))
     returns = [episode["return"] for episode in summary.get("recent_episodes", [])]
     reward = float(np.mean(returns)) if returns else None
-    return scores(summary["timesteps"], reward, last_evaluation(folder))
+    return scores(summary["timesteps"], reward, evaluations_so_far(folder))
 
 
 @dataclasses.dataclass(frozen=True)

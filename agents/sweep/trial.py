@@ -20,9 +20,8 @@ from stable_baselines3.common.callbacks import BaseCallback
 from agents.sweep.config import SweepConfig
 from agents.sweep.learners import run_trial as run_learner
 from agents.sweep.results import (
-    EVALUATIONS_FILE,
+    evaluations_so_far,
     final_scores,
-    last_evaluation,
     scores,
     trial_finished,
 )
@@ -30,7 +29,7 @@ from agents.sweep.results import (
 
 class TuneReportCallback(BaseCallback):
     """After every rollout but the last, report to Tune the training steps, the mean return of
-    the recent training episodes and the training run's last evaluation against the paper
+    the recent training episodes and the training run's evaluations against the paper
     trigger (read from its ``evaluations.json``; see :func:`agents.sweep.results.scores`).
 
     The last rollout (``total_timesteps`` reached) reports nothing: a scheduler stops a trial
@@ -55,10 +54,7 @@ class TuneReportCallback(BaseCallback):
             return
         episodes = self.model.ep_info_buffer
         reward = float(np.mean([episode["r"] for episode in episodes])) if episodes else None
-        evaluation = None
-        if (self.run_folder / EVALUATIONS_FILE).is_file():
-            evaluation = last_evaluation(self.run_folder)
-        reported = scores(self.num_timesteps, reward, evaluation)
+        reported = scores(self.num_timesteps, reward, evaluations_so_far(self.run_folder))
         if self.metric is None or self.metric in reported:
             tune.report(reported)
 
