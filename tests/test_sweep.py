@@ -196,7 +196,7 @@ def test_a_search_runs_under_asha_and_optuna_to_saved_models(tmp_path: Path) -> 
         "optuna", reason="Optuna: the sweep extra is not installed (pip install -e '.[sweep]')"
     )
     search = {
-        "hyperparameters.learning_rate": {"loguniform": [1.0e-4, 1.0e-3]},
+        "hyperparameters.learning_rate": {"loguniform": [1.0e-4, 3.0e-3]},
         "env_kwargs.transmission_penalty": {"choice": [30.0, 100.0]},
     }
     objective = {"scheduler": "asha", "search_algorithm": "optuna", "metric": "cost_ratio"}
@@ -207,9 +207,16 @@ def test_a_search_runs_under_asha_and_optuna_to_saved_models(tmp_path: Path) -> 
     assert summary["kind"] == "search" and summary["counts"]["finished"] == 2
     for trial in summary["trials"]:
         assert set(trial["values"]) == set(search)
-        assert 1.0e-4 <= trial["values"]["hyperparameters.learning_rate"] <= 1.0e-3
+        assert 1.0e-4 <= trial["values"]["hyperparameters.learning_rate"] <= 3.0e-3
         assert trial["name"].startswith("learning_rate=") and ",trial=" in trial["name"]
         assert (tmp_path / "sweep" / trial["folder"] / "model.zip").is_file()
+    base = yaml.safe_load((ROOT / "configs/train/attitude_tracking_ppo.yaml").read_text())
+    start = {
+        "hyperparameters.learning_rate": base["hyperparameters"]["learning_rate"],
+        "env_kwargs.transmission_penalty": base["env_kwargs"]["transmission_penalty"],
+    }
+    drawn = [trial["values"] for trial in summary["trials"]]
+    assert start in drawn, "Optuna evaluates the start (the base with the overrides)"
 
 
 def test_the_last_rollout_is_left_to_the_final_report(monkeypatch, tmp_path: Path) -> None:
@@ -231,13 +238,14 @@ def test_the_last_rollout_is_left_to_the_final_report(monkeypatch, tmp_path: Pat
     waiting.num_timesteps = 1024
     waiting.on_rollout_end()
     assert reports == [], "no report before the first evaluation gives the objective"
-    evaluation = {"mean_cost": 2.0, "transmissions": 10, "failure": None}
+    evaluation = {"mean_cost": 2.0, "transmissions": 10, "return": -30.0, "failure": None}
     paper = {"mean_cost": 1.0, "transmissions": 20, "failure": None}
     entry = {"timesteps": 2048, "learned": evaluation, "paper": paper}
     (tmp_path / "evaluations.json").write_text(json.dumps([entry]), encoding="utf-8")
     waiting.num_timesteps = 2048
     waiting.on_rollout_end()
     assert reports[0]["cost_ratio"] == 2.0 and reports[0]["transmission_ratio"] == 0.5
+    assert reports[0]["best_validation_return"] == -30.0
 
 
 def test_a_summary_names_the_grid_points_that_never_started(tmp_path: Path) -> None:

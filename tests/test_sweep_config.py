@@ -105,7 +105,7 @@ def test_a_front_is_never_stopped_early_or_sampled(tmp_path: Path, keys: dict[st
 
 def test_a_search_may_use_asha_and_optuna_with_an_objective(tmp_path: Path) -> None:
     search = {
-        "hyperparameters.learning_rate": {"loguniform": [1.0e-5, 1.0e-3]},
+        "hyperparameters.learning_rate": {"loguniform": [1.0e-5, 3.0e-3]},
         "hyperparameters.n_epochs": {"randint": [1, 10]},
         "env_kwargs.transmission_penalty": {"choice": [10.0, 100.0]},
     }
@@ -113,6 +113,12 @@ def test_a_search_may_use_asha_and_optuna_with_an_objective(tmp_path: Path) -> N
     objective = {"scheduler": "asha", "search_algorithm": "optuna", "metric": "cost_ratio"}
     config = sweep_config_from_dict(sweep(tmp_path, **keys, **objective, mode="min"))
     assert config.num_samples == 8
+    base = yaml.safe_load(Path(BASE).read_text())
+    assert config.search_start == {
+        "hyperparameters.learning_rate": base["hyperparameters"]["learning_rate"],
+        "hyperparameters.n_epochs": base["hyperparameters"]["n_epochs"],
+        "env_kwargs.transmission_penalty": base["env_kwargs"]["transmission_penalty"],
+    }
     assert (
         config.trial_name(
             {
@@ -152,6 +158,34 @@ SHIPPED_TUNINGS = [path for path in SHIPPED_SWEEPS if path not in SHIPPED_FRONTS
 def _penalties(config: SweepConfig) -> list[float]:
     key = "penalty" if config.learner == "search" else "env_kwargs.transmission_penalty"
     return config.grid[key]
+
+
+@pytest.mark.parametrize(
+    ("search", "overrides", "shown"),
+    [
+        ({"hyperparameters.learning_rate": {"loguniform": [1.0e-5, 1.0e-3]}}, {}, "0.00208478"),
+        ({"hyperparameters.n_epochs": {"randint": [1, 5]}}, {}, "n_epochs = 5"),
+        ({"hyperparameters.gamma": {"choice": [0.9, 0.99]}}, {}, "gamma = 0.995"),
+        (
+            {"hyperparameters.learning_rate": {"uniform": [1.0e-4, 1.0e-3]}},
+            {"hyperparameters.learning_rate": 2.0e-3},
+            "learning_rate = 0.002",
+        ),
+    ],
+)
+def test_an_optuna_search_must_start_inside_its_distributions(
+    tmp_path: Path, search: dict[str, Any], overrides: dict[str, Any], shown: str
+) -> None:
+    """Optuna's first trial is the base config with the overrides: a searched key whose start
+    lies outside its distribution is refused in one line naming it."""
+    keys = {"kind": "search", "grid": {}, "search": search, "overrides": overrides}
+    objective = {"search_algorithm": "optuna", "metric": "cost_ratio", "mode": "min"}
+    with pytest.raises(ValueError) as error:
+        sweep_config_from_dict(sweep(tmp_path, **keys, **objective))
+    message = str(error.value)
+    assert f"'search.{next(iter(search))}'" in message and shown in message
+    assert "\n" not in message
+    assert sweep_config_from_dict(sweep(tmp_path, kind="search", grid={}, search=search))
 
 
 @pytest.mark.parametrize("path", SHIPPED_FRONTS, ids=lambda path: path.stem)

@@ -28,7 +28,11 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
 * ``grace_timesteps: null`` — ASHA never stops a trial before this many timesteps (default a
   tenth of ``total_timesteps``);
 * ``search_algorithm: null`` — ``optuna`` draws the ``search`` values with Tune's
-  ``OptunaSearch`` (then ``grid`` must be empty); search only;
+  ``OptunaSearch`` (then ``grid`` must be empty); search only. Its first trial is the start
+  (:attr:`SweepConfig.search_start`: the searched keys' values in ``base`` with
+  ``overrides``, each inside its distribution), so the tuned values are compared with the
+  values the search started from, and its sampler is seeded (0): a rerun draws the same
+  trials while they do not depend on the finished ones (Optuna's start-up trials);
 * ``metric: null``, ``mode: null`` — the reported metric (:data:`agents.sweep.results.METRICS`)
   that the scheduler or search algorithm optimises, and ``min`` or ``max``; required with
   either of them. A trial reports to Tune only once it has that metric (the evaluation
@@ -152,6 +156,11 @@ class SweepConfig:
         keys = list(self.grid)
         combinations = itertools.product(*self.grid.values())
         return [dict(zip(keys, values, strict=True)) for values in combinations]
+
+    @property
+    def search_start(self) -> dict[str, Any]:
+        """The searched keys' values before the search: ``base`` with ``overrides``."""
+        return {key: _value_at(self.base, key) for key in self.search}
 
     def trial_name(self, values: Mapping[str, Any], trial_id: str | None = None) -> str:
         """A trial's folder name: its swept values as ``key=value`` joined by commas (the last
@@ -288,6 +297,8 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
         )
     if not grid and not search:
         raise ValueError("sweep keys 'grid' and 'search' are both empty: a sweep needs trials")
+    if search_algorithm is not None:
+        _check_search_start(base, search)
     metric, mode = _check_objective(values["metric"], values["mode"], scheduler, search_algorithm)
     config = SweepConfig(
         path=path,
@@ -340,6 +351,38 @@ def _assign(raw: dict[str, Any], key: str, value: Any) -> None:
         return
     nested = raw.get(top)
     raw[top] = {**(nested if isinstance(nested, dict) else {}), inner: copy.deepcopy(value)}
+
+
+def _value_at(raw: Mapping[str, Any], key: str) -> Any:
+    """The value of the dotted training-config ``key`` in ``raw`` (``None`` where unset)."""
+    top, _, inner = key.partition(".")
+    nested = raw.get(top)
+    if not inner:
+        return nested
+    return nested.get(inner) if isinstance(nested, dict) else None
+
+
+def _check_search_start(base: Mapping[str, Any], search: Mapping[str, Any]) -> None:
+    """An Optuna search starts from the searched keys' values in ``base`` (with the
+    ``overrides``): each must lie inside its distribution."""
+    for key, spec in search.items():
+        ((distribution, arguments),) = spec.items()
+        start = _value_at(base, key)
+        if distribution == "choice":
+            inside = start in arguments
+        else:
+            number = isinstance(start, int | float) and not isinstance(start, bool)
+            low, high = arguments
+            if distribution == "randint":
+                inside = number and isinstance(start, int) and low <= start < high
+            else:
+                inside = number and low <= start <= high
+        if not inside:
+            raise ValueError(
+                f"sweep key 'search.{key}': the search starts from {key} = {start!r} (the base "
+                f"config with the overrides), outside {{{distribution}: {arguments!r}}}; set it "
+                "inside with 'overrides'"
+            )
 
 
 def _check_key_set(raw: Mapping[str, Any]) -> None:

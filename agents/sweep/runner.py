@@ -51,6 +51,9 @@ from agents.sweep.results import (
 )
 from etsc_envs.core.files import require_writable_folder
 
+OPTUNA_SEED = 0
+"""The seed of an Optuna search's sampler (:mod:`agents.sweep.config`)."""
+
 
 def connect(address: str | None) -> None:
     """Join the Ray cluster at ``address`` (:func:`agents.sweep.cluster.join`), or start a Ray
@@ -124,7 +127,7 @@ def _search_algorithm(sweep: SweepConfig) -> Any:
         return None
     from ray.tune.search.optuna import OptunaSearch
 
-    return OptunaSearch()
+    return OptunaSearch(points_to_evaluate=[sweep.search_start], seed=OPTUNA_SEED)
 
 
 def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
