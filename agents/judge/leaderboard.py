@@ -155,6 +155,17 @@ BOARDS = (
         "002",
         "AttitudeTracking-v0_learned_wide_exponent",
         {
+            "per-instant PPO": LearnerRecord(
+                "AttitudeTracking-v0_ppo/transmission_penalty=300",
+                "hyperparameters tuned on validation (Optuna, 16 trials), 5 seeds at λ = 300, "
+                "best-validation checkpoints (no λ of 100, 300 contained the paper rule on "
+                "validation; 300 came closest)",
+                learner_front(
+                    "etsc/AttitudeTracking-v0",
+                    "attitude_tracking_ppo_front",
+                    "AttitudeTracking-v0_ppo",
+                ),
+            ),
             "self-triggered PPO": LearnerRecord(
                 "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
                 "holds or eq. (27) × f from scratch, 5 seeds at λ = 300, best-validation "
@@ -165,7 +176,7 @@ BOARDS = (
                     "attitude_tracking_self_triggered_front",
                     "AttitudeTracking-v0_self_triggered_scratch",
                 ),
-            )
+            ),
         },
     ),
     Board(
