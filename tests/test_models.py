@@ -27,41 +27,35 @@ project's 2-core machine (deterministic on each). Every other id's rows are repr
 last digit."""
 
 
-TRAINED_IN_FRONTS = {
-    "AttitudeTracking-v0_ppo": "AttitudeTracking-v0_ppo/transmission_penalty=300",
+SHIPPED_FROM_FRONTS = {
+    "AttitudeTracking-v0_ppo": ("AttitudeTracking-v0_ppo/transmission_penalty=300", 0),
     "AttitudeTracking-v0_self_triggered": (
-        "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300"
+        "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
+        0,
     ),
     "AsteroidOrbitKeeping-v0_self_triggered": (
-        "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3"
+        "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
+        0,
     ),
     "InnerFormation-v0_self_triggered": (
-        "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5"
+        "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
+        4,
     ),
 }
-"""The record of each model shipped from a protocol front (``agents.results --sweep``): the
-chosen penalty's seeds, one of which is the shipped model; the other models' record is
-``docs/results/<model>/``."""
-SHIPPED_SEEDS = {
-    "AttitudeTracking-v0_ppo": 0,
-    "AttitudeTracking-v0_self_triggered": 0,
-    "AsteroidOrbitKeeping-v0_self_triggered": 0,
-    "InnerFormation-v0_self_triggered": 4,
-}
-"""Which seed of its front each of those models is (the best on validation at the chosen
-penalty)."""
+"""Each model shipped from a protocol front (``agents.results --sweep``): the record of the
+chosen penalty's seeds, and which seed the model is (the best on validation); every other
+model's record is ``docs/results/<model>/``."""
 
 
 def recorded_paper_row(model: Path) -> tuple[dict, dict]:
     """The judged record of a shipped model and its row on the paper scenario."""
-    folder = TRAINED_IN_FRONTS.get(model.stem, model.stem)
+    folder, seed = SHIPPED_FROM_FRONTS.get(model.stem, (model.stem, None))
     recorded = json.loads((RESULTS / folder / "results.json").read_text(encoding="utf-8"))
     rows = recorded["sets"]["paper"]["models"]
-    if model.stem in SHIPPED_SEEDS:
-        seed = f"seed={SHIPPED_SEEDS[model.stem]}/"
-        (row,) = [row for row in rows if seed in row["model"]]
-        return recorded, row
-    return recorded, rows[0]
+    if seed is None:
+        return recorded, rows[0]
+    (row,) = [row for row in rows if f"seed={seed}/" in row["model"]]
+    return recorded, row
 
 
 def env_id_of(model: Path) -> str:

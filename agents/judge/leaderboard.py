@@ -426,14 +426,7 @@ def board_rows(records: Path, board: Board) -> list[Row]:
             {name: _record_measure(hand, name, "learned") for name in SETS},
             hand_command,
         ),
-        *(
-            _results_row(records, record.folder, trigger, record.what, command=record.command)
-            if (record := board.learners.get(trigger)) is not None
-            else _results_row(records, f"{board.name}_ppo", trigger, PRE_PROTOCOL_PPO)
-            if trigger == PER_INSTANT_PPO
-            else _results_row(records, None, trigger, NOT_TRAINED)
-            for trigger in RL_TRIGGERS
-        ),
+        *(_learner_row(records, board, trigger) for trigger in RL_TRIGGERS),
         _results_row(
             records,
             board.learned,
@@ -443,6 +436,17 @@ def board_rows(records: Path, board: Board) -> list[Row]:
         ),
         _oracle_row(records, board),
     ]
+
+
+def _learner_row(records: Path, board: Board, trigger: str) -> Row:
+    """An SB3 learner's row: its protocol record where one was judged; else per-instant PPO's
+    pre-protocol record, or a row saying none was trained."""
+    record = board.learners.get(trigger)
+    if record is not None:
+        return _results_row(records, record.folder, trigger, record.what, command=record.command)
+    if trigger == PER_INSTANT_PPO:
+        return _results_row(records, f"{board.name}_ppo", trigger, PRE_PROTOCOL_PPO)
+    return _results_row(records, None, trigger, NOT_TRAINED)
 
 
 def _oracle_row(records: Path, board: Board) -> Row:
@@ -528,8 +532,7 @@ def _table(rows: list[Row]) -> list[str]:
 
 PER_INSTANT_PPO = "per-instant PPO"
 RL_TRIGGERS = (PER_INSTANT_PPO, "self-triggered PPO", "self-triggered DQN")
-"""The rows of the SB3 learners (:attr:`Board.learners`)."""
-"""The reinforcement-learning rows, of which the README shows the best."""
+"""The rows of the SB3 learners (:attr:`Board.learners`), of which the README shows the best."""
 
 SUMMARY_TRIGGERS = ("always", "clock", HAND, *RL_TRIGGERS, LEARNED)
 """The triggers of the across-id summary, each over the ids whose record keeps its test
