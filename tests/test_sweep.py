@@ -219,6 +219,33 @@ def test_a_search_runs_under_asha_and_optuna_to_saved_models(tmp_path: Path) -> 
     assert start in drawn, "Optuna evaluates the start (the base with the overrides)"
 
 
+def test_a_search_trial_of_several_seeds_reports_their_mean(tmp_path: Path) -> None:
+    """With ``trial_seeds`` every drawn value trains once per seed, each run in its own folder,
+    and the trial's score is the mean over the seeds of their kept checkpoints' validation
+    returns."""
+    pytest.importorskip(
+        "optuna", reason="Optuna: the sweep extra is not installed (pip install -e '.[sweep]')"
+    )
+    search = {"hyperparameters.learning_rate": {"loguniform": [1.0e-4, 3.0e-3]}}
+    objective = {"search_algorithm": "optuna", "metric": "best_validation_return", "mode": "max"}
+    keys = {"kind": "search", "grid": {}, "search": search, "num_samples": 1, **objective}
+    config = tiny_sweep(tmp_path, **keys, trial_seeds=[0, 1])
+    assert main(["--config", str(config)]) == 0
+    summary = json.loads((tmp_path / "sweep" / "sweep_summary.json").read_text(encoding="utf-8"))
+    (trial,) = summary["trials"]
+    assert trial["status"] == "finished"
+    folder = tmp_path / "sweep" / trial["folder"]
+    returns = []
+    for seed in (0, 1):
+        run = folder / f"seed={seed}"
+        assert (run / "model.zip").is_file()
+        assert yaml.safe_load((run / "config.yaml").read_text())["seed"] == seed
+        evaluations = json.loads((run / "evaluations.json").read_text(encoding="utf-8"))
+        returns.append(max(entry["learned"]["return"] for entry in evaluations))
+    assert returns[0] != returns[1], "the seeds train differently"
+    assert trial["scores"]["best_validation_return"] == pytest.approx(sum(returns) / 2)
+
+
 def test_the_last_rollout_is_left_to_the_final_report(monkeypatch, tmp_path: Path) -> None:
     """A scheduler stops a trial that reports its full length: that report must come after
     the model is saved, not from the training loop."""

@@ -146,6 +146,44 @@ def test_a_search_may_use_asha_and_optuna_with_an_objective(tmp_path: Path) -> N
         sweep_config_from_dict(sweep(tmp_path, kind="search", search=bad))
 
 
+RATE = {"hyperparameters.learning_rate": {"loguniform": [1.0e-5, 1.0e-3]}}
+
+
+def test_a_search_trial_of_several_seeds_trains_each_in_its_own_folder(tmp_path: Path) -> None:
+    config = sweep_config_from_dict(
+        sweep(tmp_path, kind="search", grid={}, search=RATE, trial_seeds=[3, 7])
+    )
+    assert config.trial_seeds == (3, 7)
+    runs = config.trial_runs({"hyperparameters.learning_rate": 1.0e-4}, tmp_path / "t")
+    assert [folder for _, folder in runs] == [tmp_path / "t" / "seed=3", tmp_path / "t" / "seed=7"]
+    for (values, folder), seed in zip(runs, (3, 7), strict=True):
+        trial = config.trial_config(values, folder)
+        assert (trial.seed, trial.hyperparameters["learning_rate"]) == (seed, 1.0e-4)
+    plain = sweep_config_from_dict(sweep(tmp_path, kind="search", grid={}, search=RATE))
+    assert plain.trial_runs({"seed": 1}, tmp_path / "t") == [({"seed": 1}, tmp_path / "t")]
+
+
+@pytest.mark.parametrize(
+    ("keys", "message"),
+    [
+        ({"trial_seeds": [1]}, "'trial_seeds' must be a list of two or more distinct integer"),
+        ({"trial_seeds": [1, 1]}, "'trial_seeds' must be a list of two or more distinct integer"),
+        ({"trial_seeds": [1, 2.5]}, "'trial_seeds' must be a list of two or more distinct"),
+        ({"trial_seeds": 3}, "'trial_seeds' must be a list of two or more distinct integer"),
+        ({"kind": "front", "search": {}, "grid": {"seed": [1]}}, "not with kind 'front'"),
+        ({"scheduler": "asha", "metric": "cost_ratio", "mode": "min"}, "not with scheduler 'asha'"),
+        ({"grid": {"seed": [1, 2]}}, "not with 'seed' swept in 'grid' or 'search'"),
+    ],
+)
+def test_bad_trial_seeds_are_refused_in_one_line(
+    tmp_path: Path, keys: dict[str, Any], message: str
+) -> None:
+    raw = {"kind": "search", "grid": {}, "search": RATE, "trial_seeds": [0, 1], **keys}
+    with pytest.raises(ValueError) as error:
+        sweep_config_from_dict(sweep(tmp_path, **raw))
+    assert message in str(error.value) and "\n" not in str(error.value)
+
+
 SHIPPED_SWEEPS = sorted(
     path for path in (ROOT / "configs" / "sweeps").glob("*.yaml") if path.name != "tiny.yaml"
 )

@@ -20,6 +20,7 @@ from agents.sweep.results import (
     finished_trials,
     read_sweep,
     scores,
+    trial_scores,
     trial_status,
     write_summary,
 )
@@ -60,6 +61,21 @@ def test_the_best_validation_return_is_the_kept_checkpoints_not_the_last() -> No
     assert scores(1024, None, history[:1])["best_validation_return"] == -9.0
 
 
+def test_a_trial_of_several_seeds_scores_their_mean_once_all_finished(tmp_path: Path) -> None:
+    runs = [tmp_path / "seed=0", tmp_path / "seed=1"]
+    for run, best in zip(runs, (-4.0, -2.0), strict=True):
+        run.mkdir()
+        history = [evaluation(1.0, 30, 1.0, 120, learned_return=r) for r in (-9.0, best)]
+        (run / "evaluations.json").write_text(json.dumps(history), encoding="utf-8")
+    summary = {"timesteps": 2048, "recent_episodes": [{"return": -1.0}]}
+    (runs[0] / "train_summary.json").write_text(json.dumps(summary), encoding="utf-8")
+    assert trial_scores(runs) is None, "seed 1 has not finished"
+    (runs[1] / "train_summary.json").write_text(json.dumps(summary), encoding="utf-8")
+    both = trial_scores(runs)
+    assert both is not None and both["best_validation_return"] == -3.0
+    assert trial_scores(runs[:1]) == final_scores(runs[0])
+
+
 def make_sweep(results_dir: Path) -> None:
     """A sweep folder of two trials: one finished with a small model, one failed."""
     finished = results_dir / "trials" / "transmission_penalty=30"
@@ -77,7 +93,7 @@ def make_sweep(results_dir: Path) -> None:
         SweepTrial(
             "transmission_penalty=30",
             {"env_kwargs.transmission_penalty": 30.0},
-            trial_status(finished, None),
+            trial_status([finished], None),
             None,
             finished,
             final_scores(finished),
@@ -85,7 +101,7 @@ def make_sweep(results_dir: Path) -> None:
         SweepTrial(
             "transmission_penalty=-1",
             {"env_kwargs.transmission_penalty": -1.0},
-            trial_status(failed, error),
+            trial_status([failed], error),
             error,
             failed,
             None,
@@ -99,7 +115,7 @@ def test_the_summary_reads_back_and_only_finished_trials_count(tmp_path: Path) -
     summary = json.loads((tmp_path / "sweep" / "sweep_summary.json").read_text("utf-8"))
     assert summary["counts"] == {"finished": 1, "failed": 1, "incomplete": 0}
     assert summary["trials"][0]["scores"] == {"timesteps": 32, "training_reward": -2.0}
-    assert trial_status(tmp_path / "sweep" / "trials", None) == "incomplete"
+    assert trial_status([tmp_path / "sweep" / "trials"], None) == "incomplete"
     trials = read_sweep(tmp_path / "sweep")
     assert [trial.status for trial in trials] == ["finished", "failed"]
     assert trials[1].error.startswith("ValueError: transmission_penalty")

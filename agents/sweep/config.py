@@ -37,6 +37,12 @@ A sweep config is a YAML mapping with these keys (the optional ones show their d
   that the scheduler or search algorithm optimises, and ``min`` or ``max``; required with
   either of them. A trial reports to Tune only once it has that metric (the evaluation
   metrics need ``evaluation_every``);
+* ``trial_seeds: null`` — a list of training seeds: each trial of a search then trains once
+  per seed (its values with ``seed`` set; one after another, in its folder's ``seed=S/``)
+  and reports, once every seed has finished, the mean of their scores, so that a value is
+  chosen for what it does over several seeds rather than for one seed's luck (learner
+  ``train``, kind ``search``; no scheduler, which would compare one seed's partial runs
+  with others', and ``seed`` swept nowhere else);
 * ``cpus_per_trial: 1`` — CPU cores each trial reserves on the Ray cluster, so a 2-core
   machine runs two trials at a time and a cluster as many as it has cores;
 * ``max_concurrent_trials: null`` — at most this many trials at once (null: as many as the
@@ -98,6 +104,7 @@ OPTIONAL_SWEEP_DEFAULTS: dict[str, Any] = {
     "cpus_per_trial": 1,
     "max_concurrent_trials": None,
     "learner": "train",
+    "trial_seeds": None,
 }
 NESTED_TRAINING_KEYS = ("env_kwargs", "hyperparameters", "evaluation_env_kwargs")
 """Training-config keys whose value is a mapping that a dotted key may reach into."""
@@ -129,6 +136,7 @@ class SweepConfig:
     mode: str | None
     cpus_per_trial: float
     max_concurrent_trials: int | None
+    trial_seeds: tuple[int, ...] | None = None
 
     def settings(self) -> dict[str, Any]:
         """Every setting of the sweep (not the path of its YAML), as JSON-ready data."""
@@ -181,6 +189,17 @@ class SweepConfig:
     def trial_folder(self, name: str) -> Path:
         """Where the trial called ``name`` writes its training outputs."""
         return self.trials_dir / name
+
+    def trial_runs(
+        self, values: Mapping[str, Any], folder: str | Path
+    ) -> list[tuple[dict[str, Any], Path]]:
+        """The training runs of the trial with the swept ``values`` whose folder is ``folder``,
+        as (values, folder) pairs: the trial itself, or with ``trial_seeds`` one run per seed
+        in ``folder/seed=S``."""
+        folder = Path(folder)
+        if self.trial_seeds is None:
+            return [(dict(values), folder)]
+        return [({**values, "seed": seed}, folder / f"seed={seed}") for seed in self.trial_seeds]
 
     def start_or_continue(self, resume: bool, started: bool, grid_may_grow: bool = False) -> None:
         """Refuse to start over a sweep that has ``started`` (``--resume`` continues it, with
@@ -317,6 +336,9 @@ def sweep_config_from_dict(raw: Mapping[str, Any], path: str = "<sweep>") -> Swe
         cpus_per_trial=_check_positive_number("cpus_per_trial", values["cpus_per_trial"]),
         max_concurrent_trials=_check_optional_positive_int(
             "max_concurrent_trials", values["max_concurrent_trials"]
+        ),
+        trial_seeds=_check_trial_seeds(
+            values["trial_seeds"], learner, kind, scheduler, grid, search
         ),
     )
     _check_trial_configs(config)
@@ -531,6 +553,46 @@ def _check_front(
             f"sweep keys {offending} are for kind 'search': the trials of a front (kind "
             f"'front') are never stopped early or sampled, as that would bias the comparison"
         )
+
+
+def _check_trial_seeds(
+    value: Any,
+    learner: str,
+    kind: str,
+    scheduler: str | None,
+    grid: Mapping[str, Any],
+    search: Mapping[str, Any],
+) -> tuple[int, ...] | None:
+    """A search's seeds per trial: two or more distinct integers, on a training search without
+    a scheduler that sweeps ``seed`` nowhere else."""
+    if value is None:
+        return None
+    if (
+        not isinstance(value, list)
+        or len(value) < 2
+        or not all(isinstance(seed, int) and not isinstance(seed, bool) for seed in value)
+        or len(set(value)) != len(value)
+    ):
+        raise ValueError(
+            f"sweep key 'trial_seeds' must be a list of two or more distinct integer seeds, "
+            f"got {value!r}"
+        )
+    offending = [
+        reason
+        for reason, present in (
+            (f"learner {learner!r} (it trains: learner 'train')", learner != "train"),
+            (f"kind {kind!r} (a search's trials: kind 'search')", kind != "search"),
+            (f"scheduler {scheduler!r}", scheduler is not None),
+            ("'seed' swept in 'grid' or 'search'", "seed" in grid or "seed" in search),
+        )
+        if present
+    ]
+    if offending:
+        raise ValueError(
+            f"sweep key 'trial_seeds' is for a hyperparameter search whose trials train once "
+            f"per seed without a scheduler; not with {', '.join(offending)}"
+        )
+    return tuple(value)
 
 
 def _check_objective(

@@ -121,7 +121,7 @@ def run_sweep_in_processes(
             SweepTrial(
                 name=name,
                 values=values,
-                status=trial_status(folder, error),
+                status=trial_status([folder], error),
                 error=error,
                 folder=folder,
                 scores=final_scores(folder) if error is None else None,

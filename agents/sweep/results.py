@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -122,6 +123,20 @@ def final_scores(folder: str | Path) -> dict[str, Any] | None:
     return scores(summary["timesteps"], reward, evaluations_so_far(folder))
 
 
+def trial_scores(runs: Sequence[Path]) -> dict[str, Any] | None:
+    """The scores of a trial made of the training ``runs`` (folders,
+    :meth:`~agents.sweep.config.SweepConfig.trial_runs`): one run's :func:`final_scores`, or for
+    a trial of several seeds the mean over the seeds of each score every one reports; ``None``
+    until every run has finished."""
+    each = [final_scores(run) for run in runs]
+    if any(scores is None for scores in each):
+        return None
+    if len(each) == 1:
+        return each[0]
+    shared = [key for key in each[0] if all(key in scores for scores in each)]
+    return {key: float(np.mean([scores[key] for scores in each])) for key in shared}
+
+
 @dataclasses.dataclass(frozen=True)
 class SweepTrial:
     """One trial of a sweep as the summary records it."""
@@ -165,12 +180,12 @@ def trial_finished(folder: str | Path) -> bool:
     return trained or (folder / LEARNED_FILE).is_file() or (folder / ORACLE_FILE).is_file()
 
 
-def trial_status(folder: Path, error: str | None) -> str:
-    """``failed`` if the trial raised, else ``finished`` if its run (training or search)
-    finished, else ``incomplete``."""
+def trial_status(runs: Sequence[Path], error: str | None) -> str:
+    """``failed`` if the trial raised, else ``finished`` if each of its ``runs`` (folders of a
+    training, search or oracle run: one, or one per seed) finished, else ``incomplete``."""
     if error is not None:
         return "failed"
-    return "finished" if trial_finished(folder) else "incomplete"
+    return "finished" if all(trial_finished(run) for run in runs) else "incomplete"
 
 
 def write_summary(results_dir: str | Path, sweep: dict[str, Any], trials: list[SweepTrial]) -> Path:

@@ -44,8 +44,8 @@ from agents.sweep.config import SweepConfig, load_sweep_config
 from agents.sweep.processes import run_sweep_in_processes
 from agents.sweep.results import (
     SweepTrial,
-    final_scores,
     one_line_error,
+    trial_scores,
     trial_status,
     write_summary,
 )
@@ -142,14 +142,15 @@ def summarize(sweep: SweepConfig, results: Any) -> list[SweepTrial]:
         folder = sweep.trial_folder(name)
         error = None if result.error is None else one_line_error(result.error)
         values = result.config or _started_values(result.path) or grid_values.get(name, {})
+        runs = [run for _, run in sweep.trial_runs(values, folder)]
         trials.append(
             SweepTrial(
                 name=name,
                 values={key: values[key] for key in sweep.swept_keys if key in values},
-                status=trial_status(folder, error),
+                status=trial_status(runs, error),
                 error=error,
                 folder=folder,
-                scores=final_scores(folder) if error is None else None,
+                scores=trial_scores(runs) if error is None else None,
             )
         )
     if grid_values:  # grid points that Tune had not created when it was interrupted

@@ -1,5 +1,6 @@
 """One trial of a sweep, as Ray Tune runs it: one ``agents.train`` run that reports its
-progress to Tune, or one ``agents.search`` run (:mod:`agents.sweep.learners`).
+progress to Tune (or, with ``trial_seeds``, one run per seed, reported together at the end),
+or one ``agents.search`` run (:mod:`agents.sweep.learners`).
 
 The trial's folder is ``results_dir/trials/<name>`` (:meth:`SweepConfig.trial_name`). A trial
 that Tune restarts after an interruption does not train again if its training had finished
@@ -21,9 +22,9 @@ from agents.sweep.config import SweepConfig
 from agents.sweep.learners import run_trial as run_learner
 from agents.sweep.results import (
     evaluations_so_far,
-    final_scores,
     scores,
     trial_finished,
+    trial_scores,
 )
 
 
@@ -60,17 +61,20 @@ class TuneReportCallback(BaseCallback):
 
 
 def run_trial(values: dict[str, Any], sweep: SweepConfig) -> None:
-    """Tune's trainable: train the trial with the swept ``values`` into its folder, report as
-    it goes, and report the final scores once the model is saved."""
+    """Tune's trainable: train the trial with the swept ``values`` into its folder (once per
+    seed of ``trial_seeds``, each seed's run into its own subfolder), report as it goes (a
+    trial of one run), and report the final scores once every run has saved its model."""
     name = sweep.trial_name(values, tune.get_context().get_trial_id())
-    folder = sweep.trial_folder(name)
-    if not trial_finished(folder):
+    runs = sweep.trial_runs(values, sweep.trial_folder(name))
+    for run_values, folder in runs:
+        if trial_finished(folder):
+            continue
         callbacks = []
-        if sweep.learner == "train":
-            timesteps = int(sweep.trial_mapping(values, folder)["total_timesteps"])
+        if sweep.learner == "train" and len(runs) == 1:
+            timesteps = int(sweep.trial_mapping(run_values, folder)["total_timesteps"])
             callbacks.append(TuneReportCallback(folder, timesteps, sweep.metric))
-        run_learner(sweep, values, folder, callbacks)
-    tune.report(final_scores(folder))
+        run_learner(sweep, run_values, folder, callbacks)
+    tune.report(trial_scores([folder for _, folder in runs]))
 
 
 def trial_dirname(sweep: SweepConfig, trial: Any) -> str:
