@@ -223,3 +223,21 @@ def test_searches_of_one_configuration_share_one_paper_evaluation(
     paper_validation.cache_clear()
     assert [run["points"][0]["cost_ratio"] for run in runs] == [0.5, 0.5, 0.5]
     assert [kwargs["set_size"] for _, _, kwargs in calls] == [2, 3]
+
+
+def test_training_counts_the_sampling_instants_each_step_simulates(tmp_path: Path) -> None:
+    """The curves' abscissa: a per-instant step of 003's env with ``decision_interval`` 4 runs
+    4 sampling instants, a self-triggered decision the ``elapsed_steps`` it reports."""
+    pytest.importorskip("stable_baselines3")
+    from agents.train.validation_callback import PaperComparisonCallback
+
+    callback = PaperComparisonCallback(
+        "etsc/AsteroidOrbitKeeping-v0",
+        {"decision_interval": 4},
+        every=10**9,
+        out_path=tmp_path / "evaluations.json",
+        set_size=1,
+    )
+    callback.locals = {"infos": [{}, {}, {"elapsed_steps": 3}]}
+    callback._on_step()
+    assert callback.env_steps == 4 + 4 + 3

@@ -46,6 +46,7 @@ from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.lines import Line2D
 
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
@@ -60,9 +61,6 @@ DEFAULT_COST_TOLERANCE = 1.05
 BAND_POINTS = 40
 """Abscissae of a label's interval over seeds."""
 
-LEGEND_PANEL = (1, 0)
-"""The panel whose curves carry the legend's labels: transmissions against instants, which
-every run draws (a cost ratio of 0 draws no band)."""
 ZERO_LINEAR_RANGE = 0.1
 """Where a ratio reaches 0 its axis is symmetric-log, linear within this range of 0."""
 
@@ -271,13 +269,24 @@ def learning_curves(
 
 def plot(result: dict[str, Any], path: Path) -> None:
     """Cost and transmissions relative to the paper trigger, against instants and seconds."""
-    figure, axes = plt.subplots(2, 2, figsize=(11, 7), sharey="row")
+    figure, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharey="row")
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    legend = []  # one entry per method, drawn whether or not its band exists on every panel
     for index, (label, method) in enumerate(result["methods"].items()):
         colour = colours[index % len(colours)]
         bands = method.get("bands")
         seeds = len(method["runs"])
-        for run_index, run in enumerate(method["runs"]):
+        legend.append(
+            Line2D(
+                [],
+                [],
+                color=colour,
+                linewidth=2.0 if bands else 1.5,
+                marker="" if bands else ".",
+                label=f"{label} ({seeds} run{'s' if seeds > 1 else ''})",
+            )
+        )
+        for run in method["runs"]:
             points = run["points"]
             for column, x_key in enumerate(AXES):
                 x = [point[x_key] for point in points]
@@ -289,11 +298,6 @@ def plot(result: dict[str, Any], path: Path) -> None:
                         alpha=0.25 if bands else 0.8,
                         linewidth=0.8 if bands else 1.5,
                         marker="" if bands else ".",
-                        label=(
-                            f"{label} ({seeds} run{'s' if seeds > 1 else ''})"
-                            if not bands and run_index == 0 and (row, column) == LEGEND_PANEL
-                            else None
-                        ),
                     )
         if not bands:
             continue
@@ -309,7 +313,6 @@ def plot(result: dict[str, Any], path: Path) -> None:
                     band[y_key]["geometric_mean"],
                     color=colour,
                     linewidth=2.0,
-                    label=f"{label} ({seeds} runs)" if (row, column) == LEGEND_PANEL else None,
                 )
     zero = {
         y_key: any(
@@ -338,13 +341,14 @@ def plot(result: dict[str, Any], path: Path) -> None:
         axes[row, 0].set_xscale("log")
     axes[1, 0].set_xlabel("sampling instants simulated for training")
     axes[1, 1].set_xlabel("training wall time (s)")
-    figure.legend(loc="lower center", ncol=4, frameon=False)
+    figure.legend(handles=legend, loc="lower center", ncol=3, frameon=False)
     figure.suptitle(
         "validation scenarios: learned trigger relative to the paper's (thin: runs; bold and "
         "shaded: geometric mean over seeds, 95 % interval)",
         fontsize=10,
     )
-    figure.tight_layout(rect=(0, 0.06, 1, 0.95))
+    rows = -(-len(legend) // 3)
+    figure.tight_layout(rect=(0, 0.035 + 0.03 * rows, 1, 0.95))
     save(figure, path)
 
 

@@ -67,9 +67,10 @@ class PaperComparisonCallback(BaseCallback):
         out_path: JSON file that receives the list of evaluations after each one (each entry
             ``{"timesteps", "env_steps", "wall_time_s", "learned": {...}, "paper": {...}}`` with
             :func:`set_summary`'s keys; ``env_steps`` counts the sampling instants simulated
-            for training so far — equal to ``timesteps`` per instant, the sum of the decisions'
-            ``info["elapsed_steps"]`` for self-triggered decisions — and ``wall_time_s`` the
-            training time since the start, evaluations included).
+            for training so far — ``timesteps`` times the env's ``decision_interval`` (1 but
+            on 003, whose per-instant env may decide every few sampling periods), the sum of
+            the decisions' ``info["elapsed_steps"]`` for self-triggered decisions — and
+            ``wall_time_s`` the training time since the start, evaluations included).
         set_size: validation scenarios per evaluation.
         best_model_path: where the model with the highest mean validation return so far is
             saved (with its observation statistics beside it), or ``None``.
@@ -112,6 +113,7 @@ class PaperComparisonCallback(BaseCallback):
         self.decisions = decisions
         self._deployment: tuple[Any, ...] | None = None
         self.env_steps = 0
+        self.instants_per_step = int(env_kwargs.get("decision_interval", 1))
         self._started = time.perf_counter()
         self._earlier_wall_time_s = 0.0
 
@@ -129,7 +131,9 @@ class PaperComparisonCallback(BaseCallback):
 
     def _on_step(self) -> bool:
         infos = self.locals.get("infos") or ()
-        self.env_steps += sum(int(info.get("elapsed_steps", 1)) for info in infos)
+        self.env_steps += sum(
+            int(info.get("elapsed_steps", self.instants_per_step)) for info in infos
+        )
         if self.num_timesteps < self._next_evaluation:
             return True
         self._next_evaluation += self.every
