@@ -33,6 +33,7 @@ SHIPPED_FROM_FRONTS = {
         "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
         0,
     ),
+    "AsteroidOrbitKeeping-v0_ppo": ("AsteroidOrbitKeeping-v0_ppo/transmission_penalty=1", 3),
     "AsteroidOrbitKeeping-v0_self_triggered": (
         "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
         0,

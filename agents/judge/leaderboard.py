@@ -184,6 +184,17 @@ BOARDS = (
         "003",
         "AsteroidOrbitKeeping-v0_learned",
         {
+            "per-instant PPO": LearnerRecord(
+                "AsteroidOrbitKeeping-v0_ppo/transmission_penalty=1",
+                "hyperparameters tuned on validation (Optuna, 16 trials), 5 seeds at the "
+                "tuning's λ = 1, best-validation checkpoints (λ = 1 does not contain the paper "
+                "rule on validation)",
+                learner_front(
+                    "etsc/AsteroidOrbitKeeping-v0",
+                    "asteroid_ppo_front",
+                    "AsteroidOrbitKeeping-v0_ppo",
+                ),
+            ),
             "self-triggered PPO": LearnerRecord(
                 "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
                 "MaskablePPO: holds or eq. (15) × f from scratch, 5 seeds at λ = 0.3 chosen on "
