@@ -26,9 +26,9 @@ from agents.sweep.config import SweepConfig
 from agents.sweep.learners import run_trial
 from agents.sweep.results import (
     SweepTrial,
-    final_scores,
     one_line_error,
     trial_finished,
+    trial_scores,
     trial_status,
     write_summary,
 )
@@ -124,7 +124,7 @@ def run_sweep_in_processes(
                 status=trial_status([folder], error),
                 error=error,
                 folder=folder,
-                scores=final_scores(folder) if error is None else None,
+                scores=trial_scores([folder]) if error is None else None,
             )
         )
     write_summary(sweep.results_dir, description, trials)
