@@ -262,15 +262,20 @@ def test_a_shipped_tuning_maximises_the_kept_checkpoints_validation_return(path:
 
 
 def test_the_shipped_fronts_are_of_the_suites_ids() -> None:
-    """Each shipped front trains or searches an id of the suite (one front per id and method
-    at most: no two shipped fronts share a base config and algorithm)."""
+    """Each shipped front trains or searches an id of the suite (one front per id, method and
+    penalty set at most: no two shipped fronts share a base config, algorithm and swept
+    penalties; a chosen configuration's ten search seeds sit beside the front that chose its
+    penalty)."""
     import etsc_envs
 
     every_id = set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
     configs = [load_sweep_config(path) for path in SHIPPED_FRONTS]
     assert configs and {config.base["env_id"] for config in configs} <= every_id
     raws = [yaml.safe_load(path.read_text()) for path in SHIPPED_FRONTS]
-    methods = [(raw["base"], raw.get("overrides", {}).get("algorithm")) for raw in raws]
+    methods = [
+        (raw["base"], raw.get("overrides", {}).get("algorithm"), str(raw["grid"].get("penalty")))
+        for raw in raws
+    ]
     assert len(set(methods)) == len(methods)
 
 
