@@ -223,7 +223,7 @@ BOARDS = (
     Board(
         "etsc/InnerFormation-v0",
         "004",
-        "InnerFormation-v0_learned_large_budget",
+        "InnerFormation-v0_learned_coupled",
         {
             "self-triggered PPO": LearnerRecord(
                 "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
@@ -462,7 +462,9 @@ def _learner_row(records: Path, board: Board, trigger: str) -> Row:
 
 def _oracle_row(records: Path, board: Board) -> Row:
     """The clairvoyant schedules' row: their test scenarios' mean transmissions and cost at
-    no more than the learned trigger's cost, and learned ÷ clairvoyant (paired IQMs)."""
+    no more than the cost of the learned trigger they were searched against (the record's
+    ``trigger``, the shipped point, which may be another search's than the learned row's),
+    and learned ÷ clairvoyant (paired IQMs)."""
     path = records / board.oracle / "oracle.json"
     if not path.is_file():
         return Row(ORACLE, "not searched yet", "—", dict.fromkeys(SETS))
@@ -477,8 +479,8 @@ def _oracle_row(records: Path, board: Board) -> Row:
         else "cost at its count: both 0"
     )
     what = (
-        f"fewest transmissions at no more than the learned trigger's cost, each of the first "
-        f"{n} test scenarios known in advance (there the learned trigger: "
+        f"fewest transmissions at no more than the cost of `{oracle['trigger']}`, each of the "
+        f"first {n} test scenarios known in advance (there that trigger: "
         f"{_number(trigger['mean_cost']['mean'])} / {_number(trigger['transmissions']['mean'])});"
         f" learned ÷ clairvoyant (IQM): transmissions ×{_ratio_cell(sent, 'iqm')}, {cost_text}"
     )
