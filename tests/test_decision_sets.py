@@ -59,6 +59,17 @@ def _records(decisions: DecisionSet, actions: list[int]) -> dict[str, list]:
     return out
 
 
+def _assert_same_decisions(records: dict[str, list], expected: dict[str, list]) -> None:
+    """The same transmissions, and the same mean cost to 1e-12 relative. The compiled loop and
+    NumPy's float64 kernels are chosen for the host CPU's instruction set, so 003's costs
+    differ in the last bits between machines (seen: 9.506865225599297 against ...304); a
+    changed decision moves the count, and a changed law moves the cost far past 1e-12."""
+    assert list(records) == list(expected)
+    for label, (sent, cost) in expected.items():
+        assert records[label][0] == sent, label
+        assert records[label][1] == pytest.approx(cost, rel=1e-12, abs=0.0), label
+
+
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_a_set_reads_with_its_labels_and_round_trips(name, tmp_path):
     decisions = _read(name)
@@ -75,14 +86,15 @@ def test_a_shipped_sets_last_trigger_and_longest_hold_take_the_old_decisions(nam
     decisions = _read(name)
     chosen = [decisions.hold_indices[-1], decisions.trigger_indices[-1]]
     expected = {decisions.label(a): EXPECTED[name]["records"][decisions.label(a)] for a in chosen}
-    assert _records(decisions, chosen) == expected
+    _assert_same_decisions(_records(decisions, chosen), expected)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_every_action_of_a_shipped_set_takes_the_old_decisions(name):
     decisions = _read(name)
-    assert _records(decisions, list(range(decisions.n_actions))) == EXPECTED[name]["records"]
+    records = _records(decisions, list(range(decisions.n_actions)))
+    _assert_same_decisions(records, EXPECTED[name]["records"])
 
 
 def test_a_learned_triggers_point_is_a_trigger_action():
