@@ -160,4 +160,6 @@ def test_the_best_rl_agent_meets_the_cost_bound_first() -> None:
     assert leaderboard.best_rl_row([paper, cheap_many, within_few]) is within_few
     failed = row("self-triggered PPO", 1.0, 1.0, failures=1)
     assert leaderboard.best_rl_row([paper, cheap_many, failed]) is cheap_many
-    assert leaderboard.best_rl_row([paper, row("per-instant PPO", 1, 1, 2), failed]) is None
+    fails_more = row("per-instant PPO", 0.5, 1.0, failures=2)
+    assert leaderboard.best_rl_row([paper, fails_more, failed]) is failed
+    assert leaderboard.best_rl_row([paper]) is None

@@ -38,6 +38,12 @@ SHIPPED_FROM_FRONTS = {
         "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
         0,
     ),
+    "ClusterContainment-v0_ppo": ("ClusterContainment-v0_ppo/transmission_penalty=10", 1),
+    "ClusterContainmentCentral-v0_ppo": (
+        "ClusterContainmentCentral-v0_ppo/transmission_penalty=10",
+        0,
+    ),
+    "InnerFormation-v0_ppo": ("InnerFormation-v0_ppo/transmission_penalty=5", 3),
     "InnerFormation-v0_self_triggered": (
         "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
         4,

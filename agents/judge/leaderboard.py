@@ -134,22 +134,66 @@ class Board:
         return f"{self.name}_learned_front"
 
 
-def learner_front(env_id: str, sweep_name: str, record: str, processes: int = 2) -> str:
+def learner_front(
+    env_id: str,
+    sweep_name: str,
+    record: str,
+    processes: int = 2,
+    judged_sweep: str | None = None,
+) -> str:
     """The commands behind an SB3 learner's row: the sweep ``configs/sweeps/<sweep_name>.yaml``
     (penalties × seeds), the penalty chosen on validation, and the judgement of the sweep's
-    groups into ``docs/results/<record>``."""
-    sweep = f"runs/sweeps/{sweep_name}"
-    return (
-        f"python -m agents.sweep --processes {processes} --config configs/sweeps/"
-        f"{sweep_name}.yaml && python -m agents.judge.penalty_choice {sweep} && "
-        f"python -m agents.results {env_id} --sweep {sweep} --out docs/results/{record}"
+    groups into ``docs/results/<record>``; with ``judged_sweep``, the seeds judged are that
+    sweep's (the chosen penalty's seeds trained again, where the front kept no models)."""
+    front = f"runs/sweeps/{sweep_name}"
+    commands = [
+        f"python -m agents.sweep --processes {processes} --config configs/sweeps/{sweep_name}.yaml",
+        f"python -m agents.judge.penalty_choice {front}",
+    ]
+    if judged_sweep is not None:
+        commands.append(
+            f"python -m agents.sweep --processes {processes} --config "
+            f"configs/sweeps/{judged_sweep}.yaml"
+        )
+    judged = f"runs/sweeps/{judged_sweep or sweep_name}"
+    commands.append(
+        f"python -m agents.results {env_id} --sweep {judged} --out docs/results/{record}"
+    )
+    return " && ".join(commands)
+
+
+def cluster_ppo(env_id: str, form: str) -> LearnerRecord:
+    """Paper 001's per-instant PPO row (``form``: ``central`` or ``shared``): the front's
+    closest λ, its five seeds trained again and judged."""
+    record = f"{env_id.removeprefix('etsc/')}_ppo"
+    return LearnerRecord(
+        f"{record}/transmission_penalty=10",
+        "rl-zoo3's defaults (not tuned), 5 seeds at λ = 10 per follower update, "
+        "best-validation checkpoints (no λ of 1, 10 contained the paper rule on validation; "
+        "10 came closest)",
+        learner_front(
+            env_id,
+            f"cluster_{form}_ppo_front",
+            record,
+            judged_sweep=f"cluster_{form}_ppo",
+        ),
     )
 
 
 BOARDS = (
     Board("etsc/OrbitAttitudeTracking-v0", "000", "OrbitAttitudeTracking-v0_learned_large_budget"),
-    Board("etsc/ClusterContainment-v0", "001", "ClusterContainment-v0_learned"),
-    Board("etsc/ClusterContainmentCentral-v0", "001", "ClusterContainmentCentral-v0_learned"),
+    Board(
+        "etsc/ClusterContainment-v0",
+        "001",
+        "ClusterContainment-v0_learned",
+        {"per-instant PPO": cluster_ppo("etsc/ClusterContainment-v0", "shared")},
+    ),
+    Board(
+        "etsc/ClusterContainmentCentral-v0",
+        "001",
+        "ClusterContainmentCentral-v0_learned",
+        {"per-instant PPO": cluster_ppo("etsc/ClusterContainmentCentral-v0", "central")},
+    ),
     Board(
         "etsc/AttitudeTracking-v0",
         "002",
@@ -225,6 +269,17 @@ BOARDS = (
         "004",
         "InnerFormation-v0_learned_coupled",
         {
+            "per-instant PPO": LearnerRecord(
+                "InnerFormation-v0_ppo/transmission_penalty=5",
+                "rl-zoo3's defaults (not tuned), 5 seeds at λ = 5 per transmitted axis, "
+                "best-validation checkpoints (λ = 5 does not contain the paper rule on "
+                "validation)",
+                learner_front(
+                    "etsc/InnerFormation-v0",
+                    "inner_formation_ppo_front",
+                    "InnerFormation-v0_ppo",
+                ),
+            ),
             "self-triggered PPO": LearnerRecord(
                 "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
                 "MaskablePPO: holds or eqs. (4)–(6) × f from scratch, 5 seeds at λ = 5 (200 000 "
@@ -236,7 +291,7 @@ BOARDS = (
                     "inner_formation_self_triggered_front",
                     "InnerFormation-v0_self_triggered_scratch",
                 ),
-            )
+            ),
         },
     ),
 )
@@ -827,30 +882,30 @@ README_MARKERS = ("<!-- leaderboard: agents.leaderboard writes this table -->", 
 def best_rl_row(rows: list[Row]) -> Row | None:
     """The RL row of an id the README shows: among those with a test record and no failed
     test episode, the fewest transmissions at a cost within ×1.05 of the paper's rule's
-    (the suite's goal); where none is within it, the cheapest; ``None`` where none has a
-    record without failures."""
+    (the suite's goal); where none is within it, the cheapest; where every judged row fails
+    some test episode, the one that fails fewest (its failures are shown beside it);
+    ``None`` where no RL row has a test record."""
     by_name = {row.trigger: row for row in rows}
     paper = by_name["paper's rule"].sets["test"]
-    judged = [
-        row
-        for row in rows
-        if row.trigger in RL_TRIGGERS
-        and (measure := row.sets["test"]) is not None
-        and not measure.failures
-    ]
+    judged = [row for row in rows if row.trigger in RL_TRIGGERS and row.sets["test"] is not None]
     if paper is None or not judged:
         return None
-    limit = 1.05 * paper.cost["mean"]
 
     def test_measure(row: Row) -> Measure:
         measure = row.sets["test"]
         assert measure is not None
         return measure
 
-    within = [row for row in judged if test_measure(row).cost["mean"] <= limit]
+    clean = [row for row in judged if not test_measure(row).failures]
+    if not clean:
+        return min(
+            judged, key=lambda row: (test_measure(row).failures, test_measure(row).cost["mean"])
+        )
+    limit = 1.05 * paper.cost["mean"]
+    within = [row for row in clean if test_measure(row).cost["mean"] <= limit]
     if within:
         return min(within, key=lambda row: test_measure(row).sent["mean"])
-    return min(judged, key=lambda row: test_measure(row).cost["mean"])
+    return min(clean, key=lambda row: test_measure(row).cost["mean"])
 
 
 def _pair(measure: Measure | None) -> str:
