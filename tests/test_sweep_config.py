@@ -13,6 +13,7 @@ import yaml
 
 pytest.importorskip("stable_baselines3")
 
+from agents.judge.penalty_choice import PENALTY_KEYS
 from agents.sweep.config import SweepConfig, load_sweep_config, sweep_config_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -262,9 +263,9 @@ def test_a_shipped_tuning_maximises_the_kept_checkpoints_validation_return(path:
 
 
 def swept_penalties(grid: dict) -> list | None:
-    """A front's penalties: a search's ``penalty``, a training run's
-    ``env_kwargs.transmission_penalty``."""
-    return grid.get("penalty", grid.get("env_kwargs.transmission_penalty"))
+    """A front's penalties, under whichever of the swept keys that are λ it sweeps
+    (:data:`agents.judge.penalty_choice.PENALTY_KEYS`)."""
+    return next((grid[key] for key in PENALTY_KEYS if key in grid), None)
 
 
 def test_the_shipped_fronts_are_of_the_suites_ids() -> None:
