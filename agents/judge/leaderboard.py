@@ -17,8 +17,7 @@ that makes it:
   hand-designed rule** (``models/<EnvName>_hand.json``, a point of the family chosen on
   validation from a menu), all three from ``<EnvName>_hand/``;
 * the SB3 learners: **per-instant PPO** and, on self-triggered decisions, **PPO** and **DQN**
-  (trained from scratch under the protocol, where such runs were judged: :attr:`Board.learners`;
-  per-instant PPO otherwise from its pre-protocol record ``<EnvName>_ppo/``);
+  (trained from scratch under the protocol, where such runs were judged: :attr:`Board.learners`);
 * **learned trigger (ES)** — the searches of ``configs/search/<problem>.yaml``
   (:attr:`Board.learned`);
 * **clairvoyant schedule** — not a trigger: the fewest transmissions at no more than the
@@ -99,8 +98,7 @@ class Board:
         learned: folder of the learned trigger's ``results.json``: the searches of
             ``configs/search/<problem>.yaml``, the configuration the report chose.
         learners: the SB3 learners trained from scratch under the protocol, by row
-            (:data:`RL_TRIGGERS`); per-instant PPO without one is its pre-protocol record,
-            a self-triggered row without one says none was trained.
+            (:data:`RL_TRIGGERS`); a row without one says none was trained.
     """
 
     env_id: str
@@ -181,7 +179,24 @@ def cluster_ppo(env_id: str, form: str) -> LearnerRecord:
 
 
 BOARDS = (
-    Board("etsc/OrbitAttitudeTracking-v0", "000", "OrbitAttitudeTracking-v0_learned_large_budget"),
+    Board(
+        "etsc/OrbitAttitudeTracking-v0",
+        "000",
+        "OrbitAttitudeTracking-v0_learned_large_budget",
+        {
+            "per-instant PPO": LearnerRecord(
+                "OrbitAttitudeTracking-v0_ppo/transmission_penalty=1",
+                "rl-zoo3's defaults (not tuned), 5 seeds at the config's λ = 1 per "
+                "transmission, best-validation checkpoints (λ = 1 does not contain the paper "
+                "rule on validation)",
+                learner_front(
+                    "etsc/OrbitAttitudeTracking-v0",
+                    "orbit_attitude_ppo_front",
+                    "OrbitAttitudeTracking-v0_ppo",
+                ),
+            )
+        },
+    ),
     Board(
         "etsc/ClusterContainment-v0",
         "001",
@@ -302,9 +317,6 @@ SHORT_NAMES = {
     for board in BOARDS
 }
 """Each id as the across-id table names it: its paper, and which form of paper 001."""
-
-PRE_PROTOCOL_PPO = "one seed, trained before the protocol (checkpoint chosen on the paper scenario)"
-"""What the per-instant PPO row says where no protocol runs were judged."""
 
 
 @dataclass
@@ -505,13 +517,11 @@ def board_rows(records: Path, board: Board) -> list[Row]:
 
 
 def _learner_row(records: Path, board: Board, trigger: str) -> Row:
-    """An SB3 learner's row: its protocol record where one was judged; else per-instant PPO's
-    pre-protocol record, or a row saying none was trained."""
+    """An SB3 learner's row: its protocol record where one was judged, else a row saying none
+    was trained."""
     record = board.learners.get(trigger)
     if record is not None:
         return _results_row(records, record.folder, trigger, record.what, command=record.command)
-    if trigger == PER_INSTANT_PPO:
-        return _results_row(records, f"{board.name}_ppo", trigger, PRE_PROTOCOL_PPO)
     return _results_row(records, None, trigger, NOT_TRAINED)
 
 
