@@ -44,6 +44,10 @@ SHIPPED_FROM_FRONTS = {
         0,
     ),
     "OrbitAttitudeTracking-v0_ppo": ("OrbitAttitudeTracking-v0_ppo/transmission_penalty=1", 3),
+    "OrbitAttitudeTracking-v0_self_triggered": (
+        "OrbitAttitudeTracking-v0_self_triggered_scratch/transmission_penalty=1",
+        2,
+    ),
     "InnerFormation-v0_ppo": ("InnerFormation-v0_ppo/transmission_penalty=5", 3),
     "InnerFormation-v0_self_triggered": (
         "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",

@@ -194,7 +194,19 @@ BOARDS = (
                     "orbit_attitude_ppo_front",
                     "OrbitAttitudeTracking-v0_ppo",
                 ),
-            )
+            ),
+            "self-triggered PPO": LearnerRecord(
+                "OrbitAttitudeTracking-v0_self_triggered_scratch/transmission_penalty=1",
+                "holds or eq. (21) × γ gating a 64-instant clock, from scratch, 5 seeds at "
+                "λ = 1 (100 000 decisions, 6.8 M instants of 60-s episodes each), "
+                "best-validation checkpoints (λ = 1 does not contain the paper rule on "
+                "validation)",
+                learner_front(
+                    "etsc/OrbitAttitudeTracking-v0",
+                    "orbit_attitude_self_triggered_front",
+                    "OrbitAttitudeTracking-v0_self_triggered_scratch",
+                ),
+            ),
         },
     ),
     Board(
