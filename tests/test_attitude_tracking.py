@@ -604,6 +604,34 @@ def test_rate_bound_above_the_rate_transient_does_not_terminate():
     assert not terminated, info.get("failure")
 
 
+def test_inertia_by_rows_gives_the_array_arithmetic_bit_for_bit():
+    """J(t) = J0 + ΔJ(t) of section 4 is built as rows, with no array made per call
+    (docs/performance.md): its entries are J0's with ΔJ(t) on the diagonal, and ω̇ of eq. (1)
+    from it equals, bit for bit, the same products and solve on J(t) as a 3×3 array."""
+    from etsc_envs.attitude_tracking.closed_loop import episode_model
+    from etsc_envs.attitude_tracking.dynamics import disturbance, inertia, rate_derivative_given
+    from etsc_envs.core import vec3
+
+    env = make(randomize=True)
+    env.reset(seed=5)
+    model = episode_model(env.unwrapped.state, env.unwrapped.constants)
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        t = float(rng.uniform(0.0, 50.0))
+        omega, torque = tuple(rng.normal(scale=0.1, size=3)), tuple(rng.normal(size=3))
+        rows = inertia(t, model)
+        variation = vec3.sine_wave(
+            model.inertia_amplitude, model.inertia_frequency, t, model.inertia_phase
+        )
+        array = model.nominal_inertia.copy()
+        array[np.diag_indices(3)] += variation
+        assert_array_equal(np.array(rows), array)
+        d = disturbance(t, model)
+        gyroscopic = vec3.cross(omega, vec3.matvec(array, omega))
+        by_array = vec3.solve(array, vec3.add(vec3.add(vec3.negate(gyroscopic), torque), d))
+        assert rate_derivative_given(rows, d, omega, torque) == by_array
+
+
 def test_plant_step_evaluates_the_half_step_terms_once_bit_for_bit():
     """The RK4 step of eq. (1)-(2) computes ω_d, J and d at t + h/2 once for its two middle
     stages: it equals, bit for bit, the classical RK4 that computes every stage's terms at its

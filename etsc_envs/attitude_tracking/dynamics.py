@@ -12,7 +12,7 @@ from collections import namedtuple
 import numpy as np
 
 from etsc_envs.core import vec3
-from etsc_envs.core.jit import jit
+from etsc_envs.core.jit import inline_jit, jit
 from etsc_envs.core.rotations import attitude_matrix, quat_error, quat_rate
 
 SINUSOID, SQUARE = 0, 1
@@ -36,19 +36,21 @@ PlantModel = namedtuple(
 """Everything the plant and the desired motion depend on, as arrays and scalars."""
 
 
-@jit
-def inertia(t: float, model: PlantModel) -> np.ndarray:
-    """True inertia J(t) = J0 + ΔJ(t) of section 4."""
+@inline_jit
+def inertia(t: float, model: PlantModel) -> vec3.Mat3:
+    """True inertia J(t) = J0 + ΔJ(t) of section 4, by rows (no array is made per call)."""
     variation = vec3.sine_wave(
         model.inertia_amplitude, model.inertia_frequency, t, model.inertia_phase
     )
-    inertia_now = model.nominal_inertia.copy()
-    for axis in range(3):
-        inertia_now[axis, axis] += variation[axis]
-    return inertia_now
+    nominal = model.nominal_inertia
+    return (
+        (nominal[0, 0] + variation[0], nominal[0, 1], nominal[0, 2]),
+        (nominal[1, 0], nominal[1, 1] + variation[1], nominal[1, 2]),
+        (nominal[2, 0], nominal[2, 1], nominal[2, 2] + variation[2]),
+    )
 
 
-@jit
+@inline_jit
 def disturbance(t: float, model: PlantModel) -> vec3.Vec3:
     """External torque d(t) of section 4, N·m."""
     return vec3.sine_wave(
@@ -56,7 +58,7 @@ def disturbance(t: float, model: PlantModel) -> vec3.Vec3:
     )
 
 
-@jit
+@inline_jit
 def desired_rate(t: float, model: PlantModel) -> vec3.Vec3:
     """ω_d(t): eq. (53) for the sinusoid, eqs. (54)-(55) for the square wave."""
     if model.reference_kind == SINUSOID:
@@ -84,12 +86,12 @@ def desired_rate_derivative(t: float, model: PlantModel) -> vec3.Vec3:
     return (0.0, 0.0, 0.0)
 
 
-@jit
-def rate_derivative_given(inertia_now: np.ndarray, disturbance_now, omega, torque) -> vec3.Vec3:
-    """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, for the inertia J and disturbance d of one
-    instant."""
-    gyroscopic = vec3.cross(omega, vec3.matvec(inertia_now, omega))
-    return vec3.solve(
+@inline_jit
+def rate_derivative_given(inertia_now: vec3.Mat3, disturbance_now, omega, torque) -> vec3.Vec3:
+    """ω̇ from eq. (1), J ω̇ = -ω^× J ω + u + d, for the inertia J (by rows) and disturbance d
+    of one instant."""
+    gyroscopic = vec3.cross(omega, vec3.rows_matvec(inertia_now, omega))
+    return vec3.solve_rows(
         inertia_now, vec3.add(vec3.add(vec3.negate(gyroscopic), torque), disturbance_now)
     )
 
@@ -100,7 +102,7 @@ def rate_derivative(t: float, omega, torque, model: PlantModel) -> vec3.Vec3:
     return rate_derivative_given(inertia(t, model), disturbance(t, model), omega, torque)
 
 
-@jit
+@inline_jit
 def plant_time_terms(t: float, args):
     """What :func:`plant_derivative` needs of the time t: ``(ω_d(t), J(t), d(t))`` (eqs. 53-55
     and section 4), for the plant ``args[1]``. RK4 evaluates them once for its two stages at
@@ -109,7 +111,7 @@ def plant_time_terms(t: float, args):
     return desired_rate(t, model), inertia(t, model), disturbance(t, model)
 
 
-@jit
+@inline_jit
 def plant_derivative(time_terms, y: np.ndarray, args) -> np.ndarray:
     """ẏ for ``y = [q, ω, q_d]``: eq. (1) with the held torque ``args[0]``, and eq. (2), with
     the time-dependent terms ``time_terms`` of :func:`plant_time_terms`."""
