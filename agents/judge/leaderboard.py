@@ -248,6 +248,18 @@ BOARDS = (
                     "AttitudeTracking-v0_self_triggered_scratch",
                 ),
             ),
+            "self-triggered DQN": LearnerRecord(
+                "AttitudeTracking-v0_self_triggered_dqn/transmission_penalty=300",
+                "DQN (semi-Markov target) on the same decisions, from scratch, 5 seeds at the "
+                "PPO front's λ = 300, best-validation checkpoints (λ = 300 does not contain the "
+                "paper rule on validation: ×1.95 its transmissions at ×1.13 its cost)",
+                learner_front(
+                    "etsc/AttitudeTracking-v0",
+                    "attitude_tracking_self_triggered_dqn",
+                    "AttitudeTracking-v0_self_triggered_dqn",
+                    processes=1,
+                ),
+            ),
         },
     ),
     Board(
