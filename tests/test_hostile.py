@@ -24,6 +24,7 @@ from etsc_envs.attitude_tracking.params import AttitudeTrackingParams
 from etsc_envs.cluster.params import ClusterContainmentParams
 from etsc_envs.inner_formation.params import InnerFormationParams
 from etsc_envs.orbit_attitude.params import OrbitAttitudeParams
+from tests.child_process import interruptible
 
 GYM_IDS = sorted(etsc_envs.ENV_IDS)
 PETTINGZOO_ID = "etsc/ClusterContainment-v0"
@@ -557,7 +558,7 @@ def test_interrupted_training_resumes_with_its_whole_history(tmp_path: Path) -> 
             stdout=subprocess.DEVNULL,
             stderr=stderr_file,
             # a test run started in the background ignores SIGINT, and so would the child
-            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+            preexec_fn=interruptible,
         )
         evaluations = out_dir / "evaluations.json"
         deadline = time.monotonic() + 240
@@ -1010,7 +1011,7 @@ def test_an_interrupted_process_sweep_says_how_to_resume(tmp_path: Path) -> None
             cwd=Path(__file__).parents[1],
             stdout=subprocess.DEVNULL,
             stderr=stderr_file,
-            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+            preexec_fn=interruptible,
         )
         trials = tmp_path / "sweep" / "trials"
         deadline = time.monotonic() + 240

@@ -24,6 +24,7 @@ pytest.importorskip(
 )
 
 from agents.sweep.runner import main
+from tests.child_process import interruptible
 from tests.sweep_fixtures import tiny_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,7 +69,7 @@ def interrupted_sweep(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any
         stdout=log,
         stderr=log,
         # a test run started in the background inherits SIGINT ignored; the sweep must not
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        preexec_fn=interruptible,
     )
     deadline = time.monotonic() + START_TIMEOUT_S
     while not first_model.is_file() and process.poll() is None and time.monotonic() < deadline:
