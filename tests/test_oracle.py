@@ -17,6 +17,7 @@ from agents.oracle.__main__ import main as oracle_main
 from agents.oracle.run import oracle_config_from_dict, run_oracle
 from agents.oracle.schedule import Schedule, ScheduleRun, trigger_schedule
 from agents.oracle.search import clairvoyant
+from agents.oracle.tuned import Bound, tune_on_scenario
 from agents.sweep.config import sweep_config_from_dict
 from agents.sweep.processes import run_sweep_in_processes
 from etsc_envs.protocol import scenario_set
@@ -166,8 +167,7 @@ def test_a_multi_channel_schedule_replays_per_channel() -> None:
 # ------------------------------------------------------------------------- the search
 @pytest.fixture(scope="module")
 def found(run: ScheduleRun) -> dict:
-    trigger = LearnedTrigger.load(TRIGGER).policy_for(run.env)
-    return clairvoyant(run, trigger, budget_steps=6 * run.n_steps, tail=None)
+    return clairvoyant(run, LearnedTrigger.load(TRIGGER), budget_steps=6 * run.n_steps, tail=None)
 
 
 def test_the_search_keeps_its_constraints_on_the_exact_run(run: ScheduleRun, found: dict) -> None:
@@ -189,7 +189,7 @@ def test_the_search_keeps_its_constraints_on_the_exact_run(run: ScheduleRun, fou
 
 def test_the_windowed_search_keeps_its_constraints_too() -> None:
     run = ScheduleRun(MULTI, scenario_set("test", 1), scenario_set("test", 1).seeds[0])
-    trigger = LearnedTrigger.load("models/InnerFormation-v0_learned.json").policy_for(run.env)
+    trigger = LearnedTrigger.load("models/InnerFormation-v0_learned.json")
     found = clairvoyant(run, trigger, budget_steps=run.n_steps // 2, tail=1)
     for objective in ("fewest_transmissions", "least_cost"):
         assert found[objective]["transmissions"] <= found["trigger"]["transmissions"]
@@ -203,7 +203,7 @@ def test_a_clock_that_fails_is_no_start() -> None:
         "etsc/AsteroidOrbitKeeping-v0", scenario_set("test", 1), scenario_set("test", 1).seeds[0]
     )
     trigger = LearnedTrigger.load("models/AsteroidOrbitKeeping-v0_learned.json")
-    found = clairvoyant(run, trigger.policy_for(run.env), budget_steps=run.n_steps, tail=None)
+    found = clairvoyant(run, trigger, budget_steps=run.n_steps, tail=None)
     assert found["least_cost"]["starts"]["clock"] is None
     assert found["least_cost"]["transmissions"] <= found["trigger"]["transmissions"]
 
@@ -217,6 +217,78 @@ def test_every_start_is_recorded_with_its_curve(found: dict) -> None:
     assert costs == sorted(costs, reverse=True)  # an accepted step never costs more
 
 
+# ------------------------------------------------------------------------- the tuned start
+@pytest.mark.parametrize("objective", ["fewest_transmissions", "least_cost"])
+def test_the_tuned_point_is_the_learned_one_or_better_on_its_objective(
+    run: ScheduleRun, objective: str
+) -> None:
+    """The tuning's first candidate is the learned point, so its result keeps the bound and
+    is at least as good as the trigger on the objective; its schedule is the point's own
+    episode, replayed exactly."""
+    learned = LearnedTrigger.load(TRIGGER)
+    trigger = run.outcome(trigger_schedule(run, learned.policy_for(run.env)))
+    bound = Bound(objective, trigger.cost, trigger.transmissions)
+    tuned = tune_on_scenario(run, learned, bound, 3 * run.n_steps, seed=0)
+    outcome = tuned.outcome
+    assert not outcome.failed
+    # one axis is the bound, the other the objective: the trigger meets both
+    assert outcome.transmissions <= trigger.transmissions
+    assert outcome.cost <= trigger.cost
+    point = LearnedTrigger(ENV_ID, learned.family, tuned.point, learned.keywords)
+    replay = trigger_schedule(run, point.policy_for(run.env))
+    assert np.array_equal(replay.instants, outcome.schedule.instants)
+    assert tuned.curve[0]["transmissions"] == trigger.transmissions
+    assert tuned.candidates > 1
+    sent = [entry["transmissions"] for entry in tuned.curve]
+    if objective == "fewest_transmissions":
+        assert sent == sorted(sent, reverse=True)  # the best so far never sends more
+
+
+def test_the_tuning_is_deterministic_and_seeded(run: ScheduleRun) -> None:
+    learned = LearnedTrigger.load(TRIGGER)
+    trigger = run.outcome(trigger_schedule(run, learned.policy_for(run.env)))
+    bound = Bound("least_cost", trigger.cost, trigger.transmissions)
+    first = tune_on_scenario(run, learned, bound, run.n_steps, seed=3)
+    again = tune_on_scenario(run, learned, bound, run.n_steps, seed=3)
+    assert first.point == again.point and first.curve[-1]["cost"] == again.curve[-1]["cost"]
+
+
+def test_a_bound_ranks_feasible_first_then_by_the_miss_then_failures() -> None:
+    fewest = Bound("fewest_transmissions", cost=10.0, transmissions=100)
+    keys = [
+        fewest.rank_key(9.0, 80, False),
+        fewest.rank_key(10.0, 90, False),
+        fewest.rank_key(10.5, 10, False),
+        fewest.rank_key(12.0, 5, False),
+        fewest.rank_key(1.0, 1, True),
+    ]
+    assert keys == sorted(keys)
+    least = Bound("least_cost", cost=10.0, transmissions=100)
+    keys = [
+        least.rank_key(5.0, 100, False),
+        least.rank_key(6.0, 50, False),
+        least.rank_key(1.0, 101, False),
+        least.rank_key(0.0, 150, False),
+        least.rank_key(0.0, 1, True),
+    ]
+    assert keys == sorted(keys)
+
+
+def test_the_search_from_the_tuned_start_records_its_tuning(run: ScheduleRun) -> None:
+    learned = LearnedTrigger.load(TRIGGER)
+    found = clairvoyant(
+        run, learned, budget_steps=run.n_steps, tail=None, tuning_steps=2 * run.n_steps
+    )
+    for objective in ("fewest_transmissions", "least_cost"):
+        starts = found[objective]["starts"]
+        assert set(starts) == {"tuned", "clock"}
+        tuning = starts["tuned"]["tuning"]
+        assert tuning["candidates"] > 1
+        assert starts["tuned"]["start"]["transmissions"] <= found["trigger"]["transmissions"]
+        assert found[objective]["transmissions"] <= found["trigger"]["transmissions"]
+        assert found[objective]["cost"] <= found["trigger"]["cost"]
+
+
 # ------------------------------------------------------------------------- settings, command
 @pytest.mark.parametrize(
     ("change", "message"),
@@ -226,6 +298,8 @@ def test_every_start_is_recorded_with_its_curve(found: dict) -> None:
         ({"scenario": -1}, "key 'scenario' must be an index >= 0"),
         ({"budget_episodes": 0}, "key 'budget_episodes' must be a number > 0"),
         ({"tail": 1.5}, "key 'tail' must be an integer >= 0 or null"),
+        ({"tuning_episodes": -1}, "key 'tuning_episodes' must be a number >= 0"),
+        ({"tuning_episodes": True}, "key 'tuning_episodes' must be a number >= 0"),
         ({"trigger": "models/InnerFormation-v0_learned.json"}, "is a trigger of"),
         ({"speed": 2}, "unknown keys"),
     ],
@@ -247,6 +321,7 @@ def test_the_command_refuses_bad_input_in_one_line(tmp_path, capsys) -> None:
     for change, line in [
         (["--scenario", "-1"], "error: --scenario must be an index >= 0 of the set, got -1"),
         (["--budget-episodes", "0"], "error: --budget-episodes must be a number > 0, got 0.0"),
+        (["--tuning-episodes", "-2"], "error: --tuning-episodes must be a number >= 0, got -2.0"),
         (["--scenarios", "paper"], "error: --scenarios must be one of"),
     ]:
         assert oracle_main([*base, *change]) == 2

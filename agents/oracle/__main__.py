@@ -22,6 +22,7 @@ ARGUMENTS = {
     "scenario": "--scenario",
     "budget_episodes": "--budget-episodes",
     "tail": "--tail",
+    "tuning_episodes": "--tuning-episodes",
 }
 """The command-line argument of each setting (:class:`~agents.oracle.run.OracleConfig`)."""
 
@@ -48,6 +49,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--tail", default="none", help="screening window past the next send, or none (exact)"
+    )
+    parser.add_argument(
+        "--tuning-episodes",
+        type=float,
+        default=0.0,
+        help="start from the trigger's family point tuned on the scenario, in episodes (0: no)",
     )
     parser.add_argument("--out", required=True, help="folder of the record")
     parser.add_argument("--overwrite", action="store_true", help="replace a record in --out")
@@ -85,6 +92,7 @@ def _checked(args: argparse.Namespace) -> tuple[OracleConfig, Path]:
             "scenarios": args.scenarios,
             "budget_episodes": args.budget_episodes,
             "tail": tail,
+            "tuning_episodes": args.tuning_episodes,
         }
     )
     out = Path(args.out)

@@ -11,6 +11,10 @@ The settings are the keys of ``configs/oracle/<problem>.yaml`` (a sweep's ``base
 * ``budget_episodes`` — instants the search may simulate, in episodes of the id (each
   objective's search gets 3/8 from the trigger's schedule and 1/8 from the clock's,
   :data:`agents.oracle.search.START_SHARES`);
+* ``tuning_episodes`` — with a number > 0, each objective's search starts from the learned
+  trigger's family point tuned on the scenario (:mod:`agents.oracle.tuned`, that many episodes
+  of CMA-ES candidates, besides ``budget_episodes``) instead of the trigger's own schedule; 0
+  (the default) starts from the trigger's schedule;
 * ``tail`` — how a move is judged: ``null``, followed by the trigger to the horizon and run
   exactly (:func:`agents.oracle.search.improve_by_rollout`; for short episodes); an integer,
   screened over the changed channel's next send and ``tail`` instants of the schedule beyond
@@ -43,6 +47,7 @@ class OracleConfig:
     scenarios: str = "test"
     budget_episodes: float = 100.0
     tail: int | None = None
+    tuning_episodes: float = 0.0
 
     @property
     def seed(self) -> int:
@@ -71,6 +76,9 @@ def oracle_config_from_dict(raw: Any) -> OracleConfig:
     budget = values["budget_episodes"]
     if isinstance(budget, bool) or not isinstance(budget, int | float) or not budget > 0:
         raise ValueError(f"key 'budget_episodes' must be a number > 0, got {budget!r}")
+    tuning = values["tuning_episodes"]
+    if isinstance(tuning, bool) or not isinstance(tuning, int | float) or not tuning >= 0:
+        raise ValueError(f"key 'tuning_episodes' must be a number >= 0, got {tuning!r}")
     tail = values["tail"]
     if tail is not None and (isinstance(tail, bool) or not isinstance(tail, int) or tail < 0):
         raise ValueError(f"key 'tail' must be an integer >= 0 or null, got {tail!r}")
@@ -80,7 +88,9 @@ def oracle_config_from_dict(raw: Any) -> OracleConfig:
             f"key 'trigger': {values['trigger']!r} is a trigger of {learned.env_id!r}, "
             f"not of env_id {values['env_id']!r}"
         )
-    return OracleConfig(**{**values, "budget_episodes": float(budget)})
+    return OracleConfig(
+        **{**values, "budget_episodes": float(budget), "tuning_episodes": float(tuning)}
+    )
 
 
 def run_oracle(config: OracleConfig, out: str | Path) -> dict[str, Any]:
@@ -91,12 +101,12 @@ def run_oracle(config: OracleConfig, out: str | Path) -> dict[str, Any]:
     began = time.perf_counter()
     seed = config.seed
     run = ScheduleRun(config.env_id, scenario_set(config.scenarios, config.scenario + 1), seed)
-    trigger = LearnedTrigger.load(config.trigger).policy_for(run.env)
     found = clairvoyant(
         run,
-        trigger,
+        LearnedTrigger.load(config.trigger),
         round(config.budget_episodes * run.n_steps),
         config.tail,
+        round(config.tuning_episodes * run.n_steps),
     )
     record = {
         "settings": asdict(config),

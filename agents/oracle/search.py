@@ -27,6 +27,11 @@ Two ways of moving, by the length of the episode:
   schedule exactly from the start; a schedule is accepted only on its exact run, and when the
   exact run misses, the last half of the moves is dropped and it runs again.
 
+Where the run tunes (``tuning_steps``), each objective's first start is not the trigger's
+schedule but the schedule of its family point tuned on the scenario for that objective
+(:mod:`agents.oracle.tuned`): whole episodes with the trigger in the loop, the learned point
+the tuning's first candidate, so the start is never worse than the trigger's.
+
 A pass that finds nothing is followed by one at finer shift fractions. The search stops when a
 pass finds nothing at the finest shift fractions, or at its budget of simulated instants. What it
 returns is a schedule that exists, so the true limit lies at or below it: learned ÷ clairvoyant
@@ -42,16 +47,19 @@ from typing import Any
 import numpy as np
 
 from agents.oracle.schedule import Outcome, Schedule, ScheduleRun, trigger_schedule
+from agents.oracle.tuned import Bound, tune_on_scenario
 from etsc_envs.triggers.base import RuleTrigger
+from etsc_envs.triggers.family import LearnedTrigger
 
 SHIFT_FRACTIONS = ((0.5,), (0.25,), (0.1,))
 """Fractions of the gap to a channel's neighbouring send that a send is moved by: the coarse
 one first, each finer one once a pass at the one before finds nothing."""
 
-START_SHARES = {"trigger": 0.375, "clock": 0.125}
+START_SHARES = {"trigger": 0.375, "tuned": 0.375, "clock": 0.125}
 """The share of the budget each objective's search gets from each start: most from the
-trigger's schedule, which starts at its cost and count; the clock's is the check that another
-start does not reach further."""
+trigger's schedule (or, where the search tunes, from the tuned point's, which takes its place),
+which starts at its cost and count; the clock's is the check that another start does not reach
+further."""
 
 CLOCK_RATIO = 1.1
 """The clock of fewest transmissions is bisected (geometrically) on its period to this ratio
@@ -346,14 +354,21 @@ def _clock_least_cost(run: ScheduleRun, transmissions: int) -> Outcome:
 
 
 def clairvoyant(
-    run: ScheduleRun, trigger_policy: RuleTrigger, budget_steps: int, tail: int | None
+    run: ScheduleRun,
+    learned: LearnedTrigger,
+    budget_steps: int,
+    tail: int | None,
+    tuning_steps: int = 0,
 ) -> dict[str, Any]:
     """The fewest-transmissions and least-cost schedules of ``run``'s scenario against the
-    trigger's ``trigger_schedule``, each searched from the trigger's and the clock's schedule
+    learned trigger's schedule, each searched from the trigger's and the clock's schedule
     with its :data:`START_SHARES` of ``budget_steps`` simulated instants (the screening
     windows reach ``tail`` instants past a changed channel's next send, or the horizon for
-    ``None``). Returns the record of
-    :func:`agents.oracle.run.run_oracle` without its settings."""
+    ``None``). With ``tuning_steps``, the trigger's start is its family point tuned on the
+    scenario for the objective (:func:`agents.oracle.tuned.tune_on_scenario`, that many
+    simulated instants, the learned point its first candidate) instead of its own schedule.
+    Returns the record of :func:`agents.oracle.run.run_oracle` without its settings."""
+    trigger_policy = learned.policy_for(run.env)
     trigger = run.outcome(trigger_schedule(run, trigger_policy))
     if trigger.failed:
         raise ValueError(
@@ -388,12 +403,18 @@ def clairvoyant(
             least_cost_plan,
         ),
     }
-    for name, (clock, accept, plan) in objectives.items():
+    for number, (name, (clock, accept, plan)) in enumerate(objectives.items()):
         best: Outcome | None = None
         starts: dict[str, Any] = {}
-        for start_name in ("trigger", "clock"):
+        for start_name in ("tuned" if tuning_steps else "trigger", "clock"):
             begin = run.steps
-            start = trigger if start_name == "trigger" else clock()
+            tuning: dict[str, Any] = {}
+            if start_name == "tuned":
+                bound = Bound(name, trigger.cost, trigger.transmissions)
+                tuned = tune_on_scenario(run, learned, bound, tuning_steps, run.seed + number)
+                start, tuning = tuned.outcome, {"tuning": tuned.record()}
+            else:
+                start = trigger if start_name == "trigger" else clock()
             if start is None or start.failed:  # no clock meets the objective's bound
                 starts[start_name] = None
                 continue
@@ -409,6 +430,7 @@ def clairvoyant(
                 "end": _summary(end),
                 "curve": log.points,
                 "steps": run.steps - begin,
+                **tuning,
             }
             if best is None or accept(end, best):
                 best = end
