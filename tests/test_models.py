@@ -48,7 +48,7 @@ SHIPPED_FROM_FRONTS = {
         "OrbitAttitudeTracking-v0_self_triggered_scratch/transmission_penalty=1",
         2,
     ),
-    "InnerFormation-v0_ppo": ("InnerFormation-v0_ppo/transmission_penalty=5", 3),
+    "InnerFormation-v0_ppo": ("InnerFormation-v0_ppo/transmission_penalty=5", 1),
     "InnerFormation-v0_self_triggered": (
         "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
         4,

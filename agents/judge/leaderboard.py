@@ -309,9 +309,9 @@ BOARDS = (
         {
             "per-instant PPO": LearnerRecord(
                 "InnerFormation-v0_ppo/transmission_penalty=5",
-                "rl-zoo3's defaults (not tuned), 5 seeds at λ = 5 per transmitted axis, "
-                "best-validation checkpoints (λ = 5 does not contain the paper rule on "
-                "validation)",
+                "hyperparameters tuned on validation (6 Optuna trials × 2 seeds × 5 M steps), "
+                "5 seeds at λ = 5 per transmitted axis, best-validation checkpoints (λ = 5 "
+                "does not contain the paper rule on validation)",
                 learner_front(
                     "etsc/InnerFormation-v0",
                     "inner_formation_ppo_front",
