@@ -4,6 +4,7 @@ judgement."""
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import numpy as np
@@ -253,25 +254,38 @@ def test_the_tuning_is_deterministic_and_seeded(run: ScheduleRun) -> None:
     assert first.point == again.point and first.curve[-1]["cost"] == again.curve[-1]["cost"]
 
 
-def test_a_bound_ranks_feasible_first_then_by_the_miss_then_failures() -> None:
-    fewest = Bound("fewest_transmissions", cost=10.0, transmissions=100)
-    keys = [
-        fewest.rank_key(9.0, 80, False),
-        fewest.rank_key(10.0, 90, False),
-        fewest.rank_key(10.5, 10, False),
-        fewest.rank_key(12.0, 5, False),
-        fewest.rank_key(1.0, 1, True),
-    ]
-    assert keys == sorted(keys)
-    least = Bound("least_cost", cost=10.0, transmissions=100)
-    keys = [
-        least.rank_key(5.0, 100, False),
-        least.rank_key(6.0, 50, False),
-        least.rank_key(1.0, 101, False),
-        least.rank_key(0.0, 150, False),
-        least.rank_key(0.0, 1, True),
-    ]
-    assert keys == sorted(keys)
+@pytest.mark.parametrize(
+    ("objective", "best_first"),
+    [
+        # (cost, transmissions, failed), from the best to the worst against cost 10, 100 sends
+        (
+            "fewest_transmissions",
+            [
+                (9.0, 80, False),
+                (10.0, 90, False),
+                (10.5, 10, False),
+                (12.0, 5, False),
+                (1.0, 1, True),
+            ],
+        ),
+        (
+            "least_cost",
+            [
+                (5.0, 100, False),
+                (6.0, 50, False),
+                (1.0, 101, False),
+                (0.0, 150, False),
+                (0.0, 1, True),
+            ],
+        ),
+    ],
+)
+def test_a_bound_ranks_feasible_first_then_by_the_miss_then_failures(
+    objective: str, best_first: list[tuple[float, int, bool]]
+) -> None:
+    bound = Bound(objective, cost=10.0, transmissions=100)
+    keys = [bound.rank_key(*point) for point in best_first]
+    assert all(better < worse for better, worse in itertools.pairwise(keys))
 
 
 def test_the_search_from_the_tuned_start_records_its_tuning(run: ScheduleRun) -> None:

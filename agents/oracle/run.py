@@ -13,8 +13,10 @@ The settings are the keys of ``configs/oracle/<problem>.yaml`` (a sweep's ``base
   :data:`agents.oracle.search.START_SHARES`);
 * ``tuning_episodes`` — with a number > 0, each objective's search starts from the learned
   trigger's family point tuned on the scenario (:mod:`agents.oracle.tuned`, that many episodes
-  of CMA-ES candidates, besides ``budget_episodes``) instead of the trigger's own schedule; 0
-  (the default) starts from the trigger's schedule;
+  of CMA-ES candidates) instead of the trigger's own schedule; 0 (the default) starts from the
+  trigger's schedule. The tuning counts against its start's share of ``budget_episodes``:
+  moves from the tuned schedule get what the tuning leaves of it (nothing where the tuning
+  takes more);
 * ``tail`` — how a move is judged: ``null``, followed by the trigger to the horizon and run
   exactly (:func:`agents.oracle.search.improve_by_rollout`; for short episodes); an integer,
   screened over the changed channel's next send and ``tail`` instants of the schedule beyond

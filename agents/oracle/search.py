@@ -366,7 +366,8 @@ def clairvoyant(
     windows reach ``tail`` instants past a changed channel's next send, or the horizon for
     ``None``). With ``tuning_steps``, the trigger's start is its family point tuned on the
     scenario for the objective (:func:`agents.oracle.tuned.tune_on_scenario`, that many
-    simulated instants, the learned point its first candidate) instead of its own schedule.
+    simulated instants, the learned point its first candidate) instead of its own schedule;
+    the tuning counts against the start's share, and its moves get what is left of it.
     Returns the record of :func:`agents.oracle.run.run_oracle` without its settings."""
     trigger_policy = learned.policy_for(run.env)
     trigger = run.outcome(trigger_schedule(run, trigger_policy))
