@@ -286,6 +286,8 @@ def test_a_bound_ranks_feasible_first_then_by_the_miss_then_failures(
     bound = Bound(objective, cost=10.0, transmissions=100)
     keys = [bound.rank_key(*point) for point in best_first]
     assert all(better < worse for better, worse in itertools.pairwise(keys))
+    with pytest.raises(ValueError, match="objective must be one of"):
+        Bound("fewest", cost=10.0, transmissions=100)
 
 
 def test_the_search_from_the_tuned_start_records_its_tuning(run: ScheduleRun) -> None:

@@ -10,9 +10,9 @@ over the whole episode, at the price of one episode per candidate.
 The search is the learned trigger's own (:mod:`agents.search.cma_es`): CMA-ES (pycma) over the
 same encoding θ → x (log2 of the threshold factors, of the floor and the heartbeat; the time
 exponent; a coupled point's weights and strength), in the same box, from the learned point,
-with a step ``sigma`` in those units. It differs in what a candidate is scored by: one exact
-run of the scenario (:meth:`~agents.oracle.schedule.ScheduleRun.follow`) and the objective's
-constraint —
+with the step :data:`TUNING_SIGMA` in those units. It differs in what a candidate is scored
+by: one exact run of the scenario (:meth:`~agents.oracle.schedule.ScheduleRun.follow`) and
+the objective's constraint —
 
 * **fewest transmissions**: the fewest sends among the points whose summed cost is at most the
   learned trigger's;
@@ -40,6 +40,7 @@ TUNING_SIGMA = 0.5
 factor of about 1.4 around the learned point, whose neighbourhood the tuning refines."""
 
 OBJECTIVES = ("fewest_transmissions", "least_cost")
+"""The objectives a bound can hold (:class:`Bound`), as the clairvoyant record names them."""
 
 
 @dataclass(frozen=True)
@@ -50,6 +51,10 @@ class Bound:
     objective: str
     cost: float
     transmissions: int
+
+    def __post_init__(self) -> None:
+        if self.objective not in OBJECTIVES:
+            raise ValueError(f"objective must be one of {list(OBJECTIVES)}, got {self.objective!r}")
 
     def rank_key(self, cost: float, transmissions: int, failed: bool) -> tuple[int, float]:
         """Lower is better: ``(0, value)`` for a point within the bound (value: its sends or
