@@ -228,8 +228,7 @@ def test_the_tuned_point_is_the_learned_one_or_better_on_its_objective(
     episode, replayed exactly."""
     learned = LearnedTrigger.load(TRIGGER)
     trigger = run.outcome(trigger_schedule(run, learned.policy_for(run.env)))
-    bound = Bound(objective, trigger.cost, trigger.transmissions)
-    tuned = tune_on_scenario(run, learned, bound, 3 * run.n_steps, seed=0)
+    tuned = tune_on_scenario(run, learned, trigger, objective, 3 * run.n_steps, seed=0)
     outcome = tuned.outcome
     assert not outcome.failed
     # one axis is the bound, the other the objective: the trigger meets both
@@ -248,9 +247,8 @@ def test_the_tuned_point_is_the_learned_one_or_better_on_its_objective(
 def test_the_tuning_is_deterministic_and_seeded(run: ScheduleRun) -> None:
     learned = LearnedTrigger.load(TRIGGER)
     trigger = run.outcome(trigger_schedule(run, learned.policy_for(run.env)))
-    bound = Bound("least_cost", trigger.cost, trigger.transmissions)
-    first = tune_on_scenario(run, learned, bound, run.n_steps, seed=3)
-    again = tune_on_scenario(run, learned, bound, run.n_steps, seed=3)
+    first = tune_on_scenario(run, learned, trigger, "least_cost", run.n_steps, seed=3)
+    again = tune_on_scenario(run, learned, trigger, "least_cost", run.n_steps, seed=3)
     assert first.point == again.point and first.curve[-1]["cost"] == again.curve[-1]["cost"]
 
 

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from agents.oracle.schedule import Outcome, Schedule, ScheduleRun, trigger_schedule
-from agents.oracle.tuned import Bound, tune_on_scenario
+from agents.oracle.tuned import tune_on_scenario
 from etsc_envs.triggers.base import RuleTrigger
 from etsc_envs.triggers.family import LearnedTrigger
 
@@ -411,8 +411,9 @@ def clairvoyant(
             begin = run.steps
             tuning: dict[str, Any] = {}
             if start_name == "tuned":
-                bound = Bound(name, trigger.cost, trigger.transmissions)
-                tuned = tune_on_scenario(run, learned, bound, tuning_steps, run.seed + number)
+                tuned = tune_on_scenario(
+                    run, learned, trigger, name, tuning_steps, run.seed + number
+                )
                 start, tuning = tuned.outcome, {"tuning": tuned.record()}
             else:
                 start = trigger if start_name == "trigger" else clock()

@@ -128,30 +128,22 @@ def _run(
 def tune_on_scenario(
     run: ScheduleRun,
     learned: LearnedTrigger,
-    bound: Bound,
+    trigger: Outcome,
+    objective: str,
     budget_steps: int,
     seed: int,
 ) -> Tuned:
-    """The point of ``learned``'s family best for ``bound``'s objective on ``run``'s scenario
-    (the module docstring), searched until ``run`` has simulated ``budget_steps`` more instants
+    """The point of ``learned``'s family best for ``objective`` on ``run``'s scenario (the
+    module docstring), bounded by ``trigger`` — the learned point's own exact run there, the
+    first candidate — and searched until ``run`` has simulated ``budget_steps`` more instants
     (checked before each generation, so the last one overruns it)."""
-    import cma
-
+    bound = Bound(objective, trigger.cost, trigger.transmissions)
     space = search_space(learned, run.n_steps)
     start_point = space.decode(space.encode(learned.point).tolist())
-    rng = np.random.default_rng([seed, 20_261_206])
-    options = {
-        "bounds": [space.lower.tolist(), space.upper.tolist()],
-        "CMA_stds": space.steps.tolist(),
-        "seed": np.nan,
-        "randn": lambda lam, n: rng.standard_normal((lam, n)),
-        "verbose": -9,
-    }
-    es = cma.CMAEvolutionStrategy(space.encode(start_point).tolist(), TUNING_SIGMA, options)
+    es = space.strategy(start_point, TUNING_SIGMA, np.random.default_rng([seed, 20_261_206]))
     stop = run.steps + budget_steps
-    best_point = learned.point
-    best_schedule, best_cost, failed = _run(run, learned, best_point)
-    best_key = bound.rank_key(best_cost, best_schedule.transmissions, failed)
+    best_point, best_schedule, best_cost = learned.point, trigger.schedule, trigger.cost
+    best_key = bound.rank_key(best_cost, best_schedule.transmissions, trigger.failed)
     candidates = 1
     curve = [_entry(run, best_schedule, best_cost)]
     while run.steps < stop:
@@ -170,7 +162,8 @@ def tune_on_scenario(
         ranks[order] = np.arange(len(xs), dtype=float)
         es.tell(xs, ranks.tolist())  # CMA-ES uses the ranks alone
         curve.append(_entry(run, best_schedule, best_cost))
-    return Tuned(best_point, run.outcome(best_schedule), curve, candidates)
+    outcome = trigger if best_point is learned.point else run.outcome(best_schedule)
+    return Tuned(best_point, outcome, curve, candidates)
 
 
 def _entry(run: ScheduleRun, schedule: Schedule, cost: float) -> dict[str, float]:

@@ -342,6 +342,25 @@ class SearchSpace:
             x.extend(modulation.weights)
         return np.clip(np.array(x, dtype=float), self.lower, self.upper)
 
+    def strategy(
+        self, start: FamilyPoint, sigma: float, rng: np.random.Generator, **options: Any
+    ) -> Any:
+        """pycma's CMA-ES over this space from ``start`` with the initial step ``sigma``: the
+        box, the per-coordinate steps, and every draw from ``rng`` (pycma's own seed unused,
+        so a search is reproduced by its generator alone); ``options`` adds pycma options
+        (``popsize``, ``maxiter``)."""
+        import cma
+
+        settings = {
+            "bounds": [self.lower.tolist(), self.upper.tolist()],
+            "CMA_stds": self.steps.tolist(),
+            "seed": np.nan,
+            "randn": lambda lam, n: rng.standard_normal((lam, n)),
+            "verbose": -9,
+            **options,
+        }
+        return cma.CMAEvolutionStrategy(self.encode(start).tolist(), sigma, settings)
+
     def decode(self, x: Sequence[float]) -> FamilyPoint:
         x = np.clip(np.asarray(x, dtype=float), self.lower, self.upper)
         start = self.config.start
@@ -483,8 +502,6 @@ def run_search(
 ) -> LearnedTrigger:
     """The search of the module docstring into ``out``, continuing the generations already
     recorded in ``out/generations.jsonl``; returns the learned trigger."""
-    import cma
-
     loop_id = etsc_envs.PETTINGZOO_LOOP_IDS.get(config.env_id, config.env_id)
     env = gym.make(loop_id, **config.env_args(training=True))  # the horizon in instants
     n_steps = env.unwrapped.n_steps
@@ -496,16 +513,9 @@ def run_search(
     space = SearchSpace(config, n_steps, modulation)
     start = space.decode(space.encode(config.start))
     rng = np.random.default_rng([config.seed, 20_261_127])
-    options = {
-        "bounds": [space.lower.tolist(), space.upper.tolist()],
-        "CMA_stds": space.steps.tolist(),
-        "popsize": config.population,
-        "seed": np.nan,
-        "randn": lambda lam, n: rng.standard_normal((lam, n)),
-        "verbose": -9,
-        "maxiter": config.generations,
-    }
-    es = cma.CMAEvolutionStrategy(space.encode(start).tolist(), config.sigma, options)
+    es = space.strategy(
+        start, config.sigma, rng, popsize=config.population, maxiter=config.generations
+    )
 
     out.mkdir(parents=True, exist_ok=True)
     log_path = out / "generations.jsonl"
