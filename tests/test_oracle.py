@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import json
+from typing import Any
 
 import numpy as np
 import pytest
@@ -16,12 +17,13 @@ from agents.judge.oracle import judge, read_runs
 from agents.judge.oracle import main as judge_main
 from agents.oracle.__main__ import main as oracle_main
 from agents.oracle.run import oracle_config_from_dict, run_oracle
-from agents.oracle.schedule import Schedule, ScheduleRun, trigger_schedule
+from agents.oracle.schedule import Outcome, Schedule, ScheduleRun, trigger_schedule
 from agents.oracle.search import clairvoyant
 from agents.oracle.tuned import Bound, tune_on_scenario
 from agents.sweep.config import sweep_config_from_dict
 from agents.sweep.processes import run_sweep_in_processes
 from etsc_envs.protocol import scenario_set
+from etsc_envs.triggers.base import RuleTrigger
 from etsc_envs.triggers.family import LearnedTrigger
 
 ENV_ID = "etsc/AttitudeTracking-v0"
@@ -301,6 +303,38 @@ def test_the_search_from_the_tuned_start_records_its_tuning(run: ScheduleRun) ->
         assert starts["tuned"]["start"]["transmissions"] <= found["trigger"]["transmissions"]
         assert found[objective]["transmissions"] <= found["trigger"]["transmissions"]
         assert found[objective]["cost"] <= found["trigger"]["cost"]
+
+
+def test_the_tuned_starts_moves_are_followed_by_the_tuned_point(
+    run: ScheduleRun, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A move from the tuned start is followed by the trigger whose episode the start is —
+    the tuned point, whose own decisions replay the start's schedule — not by the learned
+    trigger, which would replace the tuned tail after any change."""
+    import agents.oracle.search as search
+
+    followed: list[tuple[Schedule, Schedule]] = []
+    improve = search.improve_by_rollout
+
+    def recording(run_: ScheduleRun, start: Outcome, trigger: RuleTrigger, *rest: Any) -> Outcome:
+        followed.append((start.schedule, trigger_schedule(run_, trigger)))
+        return improve(run_, start, trigger, *rest)
+
+    monkeypatch.setattr(search, "improve_by_rollout", recording)
+    learned = LearnedTrigger.load(TRIGGER)
+    found = clairvoyant(
+        run, learned, budget_steps=4 * run.n_steps, tail=None, tuning_steps=run.n_steps
+    )
+    calls = iter(followed)  # in order: each objective's tuned start, then its clock's if any
+    for objective in ("fewest_transmissions", "least_cost"):
+        starts = found[objective]["starts"]
+        start, replay = next(calls)
+        assert starts["tuned"]["start"]["transmissions"] == start.transmissions
+        assert np.array_equal(replay.instants, start.instants)
+        assert np.array_equal(replay.masks, start.masks)
+        if starts["clock"] is not None:
+            next(calls)
+    assert next(calls, None) is None
 
 
 # ------------------------------------------------------------------------- settings, command

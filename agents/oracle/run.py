@@ -17,9 +17,10 @@ The settings are the keys of ``configs/oracle/<problem>.yaml`` (a sweep's ``base
   trigger's schedule. The tuning counts against its start's share of ``budget_episodes``:
   moves from the tuned schedule get what the tuning leaves of it (nothing where the tuning
   takes more);
-* ``tail`` — how a move is judged: ``null``, followed by the trigger to the horizon and run
-  exactly (:func:`agents.oracle.search.improve_by_rollout`; for short episodes); an integer,
-  screened over the changed channel's next send and ``tail`` instants of the schedule beyond
+* ``tail`` — how a move is judged: ``null``, followed by the trigger to the horizon (from the
+  tuned start, by the tuned point, whose episode it is) and run exactly
+  (:func:`agents.oracle.search.improve_by_rollout`; for short episodes); an integer, screened
+  over the changed channel's next send and ``tail`` instants of the schedule beyond
   (:func:`agents.oracle.search.improve`; for long multi-channel ones).
 """
 

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from agents.oracle.schedule import Outcome, Schedule, ScheduleRun, trigger_schedule
-from agents.oracle.tuned import tune_on_scenario
+from agents.oracle.tuned import point_policy, tune_on_scenario
 from etsc_envs.triggers.base import RuleTrigger
 from etsc_envs.triggers.family import LearnedTrigger
 
@@ -367,7 +367,8 @@ def clairvoyant(
     ``None``). With ``tuning_steps``, the trigger's start is its family point tuned on the
     scenario for the objective (:func:`agents.oracle.tuned.tune_on_scenario`, that many
     simulated instants, the learned point its first candidate) instead of its own schedule;
-    the tuning counts against the start's share, and its moves get what is left of it.
+    the tuning counts against the start's share, and its moves get what is left of it, each
+    followed (where ``tail`` is ``None``) by the tuned point, whose episode the start is.
     Returns the record of :func:`agents.oracle.run.run_oracle` without its settings."""
     trigger_policy = learned.policy_for(run.env)
     trigger = run.outcome(trigger_schedule(run, trigger_policy))
@@ -410,11 +411,13 @@ def clairvoyant(
         for start_name in ("tuned" if tuning_steps else "trigger", "clock"):
             begin = run.steps
             tuning: dict[str, Any] = {}
+            follower = trigger_policy
             if start_name == "tuned":
                 tuned = tune_on_scenario(
                     run, learned, trigger, name, tuning_steps, run.seed + number
                 )
                 start, tuning = tuned.outcome, {"tuning": tuned.record()}
+                follower = point_policy(run, learned, tuned.point)
             else:
                 start = trigger if start_name == "trigger" else clock()
             if start is None or start.failed:  # no clock meets the objective's bound
@@ -424,7 +427,7 @@ def clairvoyant(
             log.note(run, start)
             share = round(START_SHARES[start_name] * budget_steps)
             if tail is None:
-                end = improve_by_rollout(run, start, trigger_policy, accept, begin + share, log)
+                end = improve_by_rollout(run, start, follower, accept, begin + share, log)
             else:
                 end = improve(run, start, accept, plan, begin + share, tail, log)
             starts[start_name] = {

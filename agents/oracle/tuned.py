@@ -33,6 +33,7 @@ import numpy as np
 
 from agents.oracle.schedule import Outcome, Schedule, ScheduleRun
 from agents.search.cma_es import EXPONENT_RANGE, SearchConfig, SearchSpace
+from etsc_envs.triggers.base import RuleTrigger
 from etsc_envs.triggers.family import FamilyPoint, LearnedTrigger
 
 TUNING_SIGMA = 0.5
@@ -111,12 +112,17 @@ def search_space(learned: LearnedTrigger, n_steps: int) -> SearchSpace:
     return SearchSpace(config, n_steps, None)
 
 
+def point_policy(run: ScheduleRun, learned: LearnedTrigger, point: FamilyPoint) -> RuleTrigger:
+    """``point`` of ``learned``'s family as a trigger in ``run``'s env."""
+    as_file = LearnedTrigger(learned.env_id, learned.family, point, learned.keywords)
+    return as_file.policy_for(run.env)
+
+
 def _run(
     run: ScheduleRun, learned: LearnedTrigger, point: FamilyPoint
 ) -> tuple[Schedule, float, bool]:
     """The point's exact episode on ``run``'s scenario: its schedule, summed cost, failure."""
-    as_file = LearnedTrigger(learned.env_id, learned.family, point, learned.keywords)
-    policy = as_file.policy_for(run.env)
+    policy = point_policy(run, learned, point)
     run.restore(run.initial)
     instants, masks, cost, failed = run.follow(policy)
     schedule = Schedule(
