@@ -467,7 +467,10 @@ def test_the_judgement_pairs_scenarios_by_seed() -> None:
         return out
 
     records = [record(s, (100, 50, 100), (2.0, 1.9, 1.0)) for s in range(4)]
+    records[0]["settings"] = {**records[0]["settings"], "tuning_episodes": 3.0}
     summary = judge(records)
+    assert summary["budget_episodes"] == [1.0]
+    assert summary["tuning_episodes"] == [0.0, 3.0]  # a run without the key did not tune
     ratios = summary["learned_over_clairvoyant"]
     assert ratios["transmissions_at_equal_cost"]["iqm"] == pytest.approx(2.0)
     assert ratios["cost_at_equal_transmissions"]["iqm"] == pytest.approx(2.0)

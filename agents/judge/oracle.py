@@ -5,10 +5,11 @@
 reads the finished trials of a ``learner: oracle`` sweep (one :mod:`agents.oracle` run per
 scenario, ``oracle.json``) and writes to ``--out``:
 
-* ``oracle.json`` — per scenario: the seed, the trigger's transmissions and mean cost, the
-  fewest-transmissions schedule's (at no more than the trigger's summed cost) and the
-  least-cost schedule's (at no more transmissions), which start each came from, the instants
-  simulated and the wall time; and over the scenarios (paired by seed,
+* ``oracle.json`` — the searches' settings (``budget_episodes`` and ``tuning_episodes``, the
+  values the runs used; ``tail``); per scenario: the seed, the trigger's transmissions and mean
+  cost, the fewest-transmissions schedule's (at no more than the trigger's summed cost) and
+  the least-cost schedule's (at no more transmissions), which start each came from, the
+  instants simulated and the wall time; and over the scenarios (paired by seed,
   :func:`~etsc_envs.evaluation.statistics.paired_ratio`): learned ÷ clairvoyant
   transmissions (IQM with its bootstrap interval), learned ÷ clairvoyant cost, and the means
   of each schedule's transmissions and mean cost
@@ -97,6 +98,10 @@ def judge(records: list[dict[str, Any]]) -> dict[str, Any]:
         "scenarios": settings["scenarios"],
         "seeds": [record["seed"] for record in records],
         "budget_episodes": sorted({record["settings"]["budget_episodes"] for record in records}),
+        # runs from before the tuned start have no tuning_episodes: they did not tune
+        "tuning_episodes": sorted(
+            {record["settings"].get("tuning_episodes", 0.0) for record in records}
+        ),
         "tail": settings["tail"],
         "learned_over_clairvoyant": {
             "transmissions_at_equal_cost": paired_ratio(
