@@ -269,10 +269,19 @@ class ScheduleRun:
         return cost - (base.costs_before[stop_index] - base.costs_before[first])
 
 
-def trigger_schedule(run: ScheduleRun, trigger: RuleTrigger) -> Schedule:
-    """The schedule ``trigger`` (a rule or family point for ``run``'s env) sends on ``run``'s
-    scenario: its decisions, interval by interval in compiled calls
+def trigger_episode(run: ScheduleRun, trigger: RuleTrigger) -> tuple[Schedule, float, bool]:
+    """The episode of ``trigger`` (a rule or family point for ``run``'s env) on ``run``'s
+    scenario from its start: the schedule it sends, its summed cost and whether it failed; its
+    decisions run interval by interval in compiled calls
     (:meth:`~etsc_envs.core.loop_env.EventTriggeredEnv.run_rule_interval`)."""
     run.restore(run.initial)
-    instants, masks, _, _ = run.follow(trigger)
-    return Schedule(np.array(instants, dtype=np.int64), np.array(masks).reshape(-1, run.n_channels))
+    instants, masks, cost, failed = run.follow(trigger)
+    schedule = Schedule(
+        np.array(instants, dtype=np.int64), np.array(masks).reshape(-1, run.n_channels)
+    )
+    return schedule, cost, failed
+
+
+def trigger_schedule(run: ScheduleRun, trigger: RuleTrigger) -> Schedule:
+    """The schedule ``trigger`` sends on ``run``'s scenario (:func:`trigger_episode`)."""
+    return trigger_episode(run, trigger)[0]

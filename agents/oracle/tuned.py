@@ -11,7 +11,7 @@ The search is the learned trigger's own (:mod:`agents.search.cma_es`): CMA-ES (p
 same encoding θ → x (log2 of the threshold factors, of the floor and the heartbeat; the time
 exponent; a coupled point's weights and strength), in the same box, from the learned point,
 with the step :data:`TUNING_SIGMA` in those units. It differs in what a candidate is scored
-by: one exact run of the scenario (:meth:`~agents.oracle.schedule.ScheduleRun.follow`) and
+by: one exact run of the scenario (:func:`~agents.oracle.schedule.trigger_episode`) and
 the objective's constraint —
 
 * **fewest transmissions**: the fewest sends among the points whose summed cost is at most the
@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from agents.oracle.schedule import Outcome, Schedule, ScheduleRun
+from agents.oracle.schedule import Outcome, Schedule, ScheduleRun, trigger_episode
 from agents.search.cma_es import EXPONENT_RANGE, SearchConfig, SearchSpace
 from etsc_envs.triggers.base import RuleTrigger
 from etsc_envs.triggers.family import FamilyPoint, LearnedTrigger
@@ -118,19 +118,6 @@ def point_policy(run: ScheduleRun, learned: LearnedTrigger, point: FamilyPoint) 
     return as_file.policy_for(run.env)
 
 
-def _run(
-    run: ScheduleRun, learned: LearnedTrigger, point: FamilyPoint
-) -> tuple[Schedule, float, bool]:
-    """The point's exact episode on ``run``'s scenario: its schedule, summed cost, failure."""
-    policy = point_policy(run, learned, point)
-    run.restore(run.initial)
-    instants, masks, cost, failed = run.follow(policy)
-    schedule = Schedule(
-        np.array(instants, dtype=np.int64), np.array(masks).reshape(-1, run.n_channels)
-    )
-    return schedule, cost, failed
-
-
 def tune_on_scenario(
     run: ScheduleRun,
     learned: LearnedTrigger,
@@ -157,7 +144,7 @@ def tune_on_scenario(
         keys = []
         for x in xs:
             point = space.decode(x)
-            schedule, cost, failed = _run(run, learned, point)
+            schedule, cost, failed = trigger_episode(run, point_policy(run, learned, point))
             key = bound.rank_key(cost, schedule.transmissions, failed)
             keys.append(key)
             if key < best_key:
