@@ -343,7 +343,8 @@ def test_the_tuned_starts_moves_are_followed_by_the_tuned_point(
     [
         ({"env_id": "etsc/ClusterContainment-v0"}, "key 'env_id' must be a single-agent id"),
         ({"scenarios": "paper"}, "key 'scenarios' must be one of"),
-        ({"scenario": -1}, "key 'scenario' must be an index >= 0"),
+        ({"scenario": -1}, "key 'scenario' must be an index 0..999999 of the test seeds"),
+        ({"scenario": 1_000_000}, "key 'scenario' must be an index 0..999999 of the test seeds"),
         ({"budget_episodes": 0}, "key 'budget_episodes' must be a number > 0"),
         ({"tail": 1.5}, "key 'tail' must be an integer >= 0 or null"),
         ({"tuning_episodes": -1}, "key 'tuning_episodes' must be a number >= 0"),
@@ -367,7 +368,7 @@ def test_the_command_refuses_bad_input_in_one_line(tmp_path, capsys) -> None:
         == "error: --tail must be an integer >= 0 or none, got 'far'"
     )
     for change, line in [
-        (["--scenario", "-1"], "error: --scenario must be an index >= 0 of the set, got -1"),
+        (["--scenario", "-1"], "error: --scenario must be an index 0..999999 of the test seeds"),
         (["--budget-episodes", "0"], "error: --budget-episodes must be a number > 0, got 0.0"),
         (["--tuning-episodes", "-2"], "error: --tuning-episodes must be a number >= 0, got -2.0"),
         (["--scenarios", "paper"], "error: --scenarios must be one of"),
