@@ -36,3 +36,29 @@ def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=900
     )
+
+
+def retrained_differences(folder: Path, out_dir: Path) -> list[str]:
+    """Train the run of a sweep trial ``folder`` again with ``agents.train`` (its resolved
+    ``config.yaml``, into ``out_dir``) and name every policy tensor and normalisation statistic
+    that differs from the trial's: a sweep's trial must be the run its config describes, so
+    that a record can be remade from its config and seed alone."""
+    import numpy as np
+    import torch
+    from stable_baselines3.common.save_util import load_from_zip_file
+
+    from agents.train.config import load_config
+    from agents.train.training import train
+
+    train(load_config(folder / "config.yaml", {"out_dir": str(out_dir)}))
+    differences = []
+    tensors = [load_from_zip_file(run / "model.zip")[1]["policy"] for run in (folder, out_dir)]
+    for name, tensor in tensors[0].items():
+        if not torch.equal(tensor, tensors[1][name]):
+            differences.append(f"policy {name}")
+    with (
+        np.load(folder / "model_vecnormalize.npz") as a,
+        np.load(out_dir / "model_vecnormalize.npz") as b,
+    ):
+        differences += [f"statistic {key}" for key in a.files if not np.array_equal(a[key], b[key])]
+    return differences

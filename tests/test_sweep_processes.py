@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from tests.sweep_fixtures import sweep_without_ray, tiny_sweep
+from tests.sweep_fixtures import retrained_differences, sweep_without_ray, tiny_sweep
 
 pytest.importorskip("stable_baselines3")
 
@@ -96,3 +96,8 @@ def test_what_processes_cannot_run_is_refused_in_one_line(
     assert run.returncode == 2
     assert message in run.stderr.strip().splitlines()[-1]
     assert not (tmp_path / "sweep" / "trials").exists()
+
+
+def test_a_trial_is_the_run_agents_train_makes_from_its_config(process_sweep, tmp_path) -> None:
+    folder = process_sweep["results_dir"] / "trials" / FINISHING[1]
+    assert retrained_differences(folder, tmp_path / "again") == []
