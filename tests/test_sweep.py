@@ -25,7 +25,7 @@ pytest.importorskip(
 
 from agents.sweep.runner import main
 from tests.child_process import interruptible
-from tests.sweep_fixtures import tiny_sweep
+from tests.sweep_fixtures import retrained_differences, tiny_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 FIRST, SECOND, CRASHING = (
@@ -146,6 +146,15 @@ def test_both_trials_leave_a_model_its_statistics_and_evaluations(interrupted_sw
         crashed["error"].startswith("ValueError: ") and "transmission_penalty" in crashed["error"]
     )
     assert "\n" not in crashed["error"] and crashed["scores"] is None
+
+
+@pytest.mark.parametrize("name", [FIRST, SECOND])
+def test_a_trial_is_the_run_agents_train_makes_from_its_config(
+    interrupted_sweep, name: str, tmp_path: Path
+) -> None:
+    """The first trial as Ray ran it, and the second as it ran again on resuming."""
+    folder = interrupted_sweep["results_dir"] / "trials" / name
+    assert retrained_differences(folder, tmp_path / "again") == []
 
 
 def test_a_finished_sweep_is_not_started_again_without_resume(interrupted_sweep, capsys) -> None:
