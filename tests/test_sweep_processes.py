@@ -5,14 +5,21 @@ refusals of what it cannot run."""
 from __future__ import annotations
 
 import json
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 
-from tests.sweep_fixtures import retrained_differences, sweep_without_ray, tiny_sweep
+from tests.sweep_fixtures import ROOT, TINY, retrained_differences, sweep_without_ray, tiny_sweep
 
 pytest.importorskip("stable_baselines3")
+
+from agents.train.training import LOCK_FILE
 
 FINISHING = ("transmission_penalty=30", "transmission_penalty=100")
 CRASHING = "transmission_penalty=-1"
@@ -101,3 +108,61 @@ def test_what_processes_cannot_run_is_refused_in_one_line(
 def test_a_trial_is_the_run_agents_train_makes_from_its_config(process_sweep, tmp_path) -> None:
     folder = process_sweep["results_dir"] / "trials" / FINISHING[1]
     assert retrained_differences(folder, tmp_path / "again") == []
+
+
+def _children(pid: int) -> set[int]:
+    """The processes ``pid`` started (Linux: ``/proc``)."""
+    found = set()
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        found |= {int(child) for child in (task / "children").read_text().split()}
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        status = Path(f"/proc/{pid}/stat").read_text().split()[2]
+    except FileNotFoundError:
+        return False
+    return status != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="reads /proc (Linux)")
+def test_sigterm_stops_the_sweep_and_its_workers(tmp_path: Path) -> None:
+    """``kill PID`` on a sweep started in the background (which ignores Ctrl-C's SIGINT)
+    stops it as Ctrl-C does, and takes its running trial's worker with it."""
+    config = tiny_sweep(
+        tmp_path,
+        grid={"env_kwargs.transmission_penalty": [30.0]},
+        overrides={
+            **yaml.safe_load(TINY.read_text(encoding="utf-8"))["overrides"],
+            "total_timesteps": 10_000_000,
+        },
+    )
+    code = (
+        "import signal, sys\n"
+        "signal.signal(signal.SIGINT, signal.SIG_IGN)  # as a background job starts\n"
+        "sys.modules['ray'] = None\n"
+        "from agents.sweep.runner import main\n"
+        f"raise SystemExit(main(['--config', {str(config)!r}, '--processes', '1']))\n"
+    )
+    sweep = subprocess.Popen(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    started = tmp_path / "sweep" / "trials" / "transmission_penalty=30" / LOCK_FILE
+    deadline = time.monotonic() + 300
+    while not started.is_file() and sweep.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.1)
+    workers = _children(sweep.pid) if sweep.poll() is None else set()
+    assert workers, f"the sweep ended or hung before its trial started: rc {sweep.poll()}"
+    sweep.send_signal(signal.SIGTERM)
+    _, stderr = sweep.communicate(timeout=120)
+    assert sweep.returncode == 130, stderr
+    assert "interrupted; finished trials are kept" in stderr
+    deadline = time.monotonic() + 30
+    while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(pid) for pid in workers), "a worker trains on after the sweep ended"

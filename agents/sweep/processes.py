@@ -10,14 +10,19 @@ whose training had finished is not run again, so the same command continues an i
 unfinished trial starts again from its newest checkpoint where its config saves them.
 
 Workers are spawned, not forked: a forked child of a process that has run torch can deadlock
-in its OpenMP pool (the reason :mod:`etsc_envs.evaluation.batch` spawns too).
+in its OpenMP pool (the reason :mod:`etsc_envs.evaluation.batch` spawns too). A sweep stops as
+Ctrl-C stops it on SIGTERM too (``kill PID``: a background job ignores SIGINT), and its
+workers end with it however it ends, so no trial trains on unseen.
 """
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import signal
+import threading
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -32,6 +37,7 @@ from agents.sweep.results import (
     trial_status,
     write_summary,
 )
+from etsc_envs.evaluation.batch import die_with_parent
 
 
 def check_process_sweep(sweep: SweepConfig, processes: int) -> None:
@@ -67,13 +73,33 @@ _STOP: Any = None
 """In a worker: the runner's event, set when the sweep is interrupted."""
 
 
-def _start_worker(stop: Any) -> None:
+def _start_worker(stop: Any, parent: int) -> None:
     """A worker between trials ignores Ctrl-C (the terminal sends it to every process of the
     sweep): the runner stops the pool, and only a running trial stops on it; once ``stop`` is
-    set, a trial still queued to the worker returns without training."""
+    set, a trial still queued to the worker returns without training. The worker ends when
+    the runner's process ``parent`` does, even if it is killed."""
     global _STOP
     _STOP = stop
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent(parent)
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """While the trials run, SIGTERM raises ``KeyboardInterrupt`` in the runner as Ctrl-C does
+    (where this is the main thread, the only one that may set a handler)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def run_sweep_in_processes(
@@ -95,12 +121,15 @@ def run_sweep_in_processes(
     if pending:
         context = multiprocessing.get_context("spawn")
         stop = context.Event()
-        with ProcessPoolExecutor(
-            min(processes, len(pending)),
-            mp_context=context,
-            initializer=_start_worker,
-            initargs=(stop,),
-        ) as pool:
+        with (
+            _terminate_as_interrupt(),
+            ProcessPoolExecutor(
+                min(processes, len(pending)),
+                mp_context=context,
+                initializer=_start_worker,
+                initargs=(stop, os.getpid()),
+            ) as pool,
+        ):
             futures = {
                 name: pool.submit(_run_trial, sweep, values, sweep.trial_folder(name))
                 for name, values in pending.items()
@@ -111,7 +140,8 @@ def run_sweep_in_processes(
                 stop.set()  # trials queued to a worker already return at once
                 pool.shutdown(wait=False, cancel_futures=True)
                 for worker in multiprocessing.active_children():  # a running trial stops
-                    os.kill(worker.pid, signal.SIGINT)
+                    if worker.pid is not None:
+                        os.kill(worker.pid, signal.SIGINT)
                 raise
     trials = []
     for name, values in points.items():
