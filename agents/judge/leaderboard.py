@@ -214,7 +214,21 @@ BOARDS = (
         "etsc/ClusterContainment-v0",
         "001",
         "ClusterContainment-v0_learned",
-        {"per-instant PPO": cluster_ppo("etsc/ClusterContainment-v0", "shared")},
+        {
+            "per-instant PPO": cluster_ppo("etsc/ClusterContainment-v0", "shared"),
+            "self-triggered PPO": LearnerRecord(
+                "ClusterContainment-v0_self_triggered_scratch/transmission_penalty=10",
+                "holds or eq. (15) × c, one policy shared by the followers, from scratch, "
+                "5 seeds at λ = 10 per follower update (12 288 follower decisions of 1200-s "
+                "episodes each), best-validation checkpoints (λ = 10 does not contain the "
+                "paper rule on validation: ×14 its updates)",
+                learner_front(
+                    "etsc/ClusterContainment-v0",
+                    "cluster_shared_self_triggered_front",
+                    "ClusterContainment-v0_self_triggered_scratch",
+                ),
+            ),
+        },
     ),
     Board(
         "etsc/ClusterContainmentCentral-v0",
