@@ -5,6 +5,7 @@ refusals of what it cannot run."""
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -126,7 +127,10 @@ def _alive(pid: int) -> bool:
     return status != "Z"
 
 
-@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="reads /proc (Linux)")
+@pytest.mark.skipif(
+    not Path(f"/proc/self/task/{os.getpid()}/children").is_file(),
+    reason="reads a process's children from /proc (Linux)",
+)
 def test_sigterm_stops_the_sweep_and_its_workers(tmp_path: Path) -> None:
     """``kill PID`` on a sweep started in the background (which ignores Ctrl-C's SIGINT)
     stops it as Ctrl-C does, and takes its running trial's worker with it."""
