@@ -160,13 +160,14 @@ def learner_front(
     return " && ".join(commands)
 
 
-def cluster_ppo(env_id: str, form: str) -> LearnerRecord:
-    """Paper 001's per-instant PPO row (``form``: ``central`` or ``shared``): the front's
-    closest λ, its five seeds trained again and judged."""
+def cluster_ppo(env_id: str, form: str, values: str) -> LearnerRecord:
+    """Paper 001's per-instant PPO row (``form``: ``central`` or ``shared``; ``values``: how
+    its hyperparameters were chosen): the front's closest λ, its five seeds trained again and
+    judged."""
     record = f"{env_id.removeprefix('etsc/')}_ppo"
     return LearnerRecord(
         f"{record}/transmission_penalty=10",
-        "rl-zoo3's defaults (not tuned), 5 seeds at λ = 10 per follower update, "
+        f"{values}, 5 seeds at λ = 10 per follower update, "
         "best-validation checkpoints (no λ of 1, 10 contained the paper rule on validation; "
         "10 came closest)",
         learner_front(
@@ -215,7 +216,9 @@ BOARDS = (
         "001",
         "ClusterContainment-v0_learned",
         {
-            "per-instant PPO": cluster_ppo("etsc/ClusterContainment-v0", "shared"),
+            "per-instant PPO": cluster_ppo(
+                "etsc/ClusterContainment-v0", "shared", "rl-zoo3's defaults (not tuned)"
+            ),
             "self-triggered PPO": LearnerRecord(
                 "ClusterContainment-v0_self_triggered_scratch/transmission_penalty=10",
                 "holds or eq. (15) × c, one policy shared by the followers, from scratch, "
@@ -234,7 +237,24 @@ BOARDS = (
         "etsc/ClusterContainmentCentral-v0",
         "001",
         "ClusterContainmentCentral-v0_learned",
-        {"per-instant PPO": cluster_ppo("etsc/ClusterContainmentCentral-v0", "central")},
+        {
+            "per-instant PPO": cluster_ppo(
+                "etsc/ClusterContainmentCentral-v0", "central", "rl-zoo3's defaults (not tuned)"
+            ),
+            "self-triggered PPO": LearnerRecord(
+                "ClusterContainmentCentral-v0_self_triggered_scratch/transmission_penalty=10",
+                "holds after every follower transmits or eq. (15) × c, from scratch, 5 seeds at "
+                "λ = 10 per follower update (20 000 decisions of 1200-s episodes each), "
+                "best-validation checkpoints (no λ of 1, 10 contained the paper rule on "
+                "validation; 10 came closest)",
+                learner_front(
+                    "etsc/ClusterContainmentCentral-v0",
+                    "cluster_central_self_triggered_front",
+                    "ClusterContainmentCentral-v0_self_triggered_scratch",
+                    judged_sweep="cluster_central_self_triggered",
+                ),
+            ),
+        },
     ),
     Board(
         "etsc/AttitudeTracking-v0",
