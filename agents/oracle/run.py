@@ -37,7 +37,12 @@ from agents.oracle.search import clairvoyant
 from agents.sweep.results import ORACLE_FILE
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.core.json_files import require_mapping
-from etsc_envs.protocol import RESERVED_SEEDS, SCENARIO_SET_NAMES, scenario_set
+from etsc_envs.protocol import (
+    DEFAULT_SET_SIZE,
+    RESERVED_SEEDS,
+    SCENARIO_SET_NAMES,
+    scenario_set,
+)
 from etsc_envs.registry import VECTOR_ENTRY_POINTS
 from etsc_envs.triggers.family import LearnedTrigger
 
@@ -78,7 +83,7 @@ def oracle_config_from_dict(raw: Any) -> OracleConfig:
     if isinstance(scenario, bool) or not isinstance(scenario, int) or not 0 <= scenario <= last:
         raise ValueError(
             f"key 'scenario' must be an index 0..{last} of the {values['scenarios']} seeds "
-            f"(the set of 64 is 0..63), got {scenario!r}"
+            f"(the protocol's set is 0..{DEFAULT_SET_SIZE - 1}), got {scenario!r}"
         )
     budget = values["budget_episodes"]
     if isinstance(budget, bool) or not isinstance(budget, int | float) or not budget > 0:
