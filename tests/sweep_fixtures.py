@@ -25,16 +25,23 @@ def tiny_sweep(tmp_path: Path, **keys: Any) -> Path:
     return path
 
 
-def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:
-    """The sweep command in a Python where ``import ray`` fails (the worker-process path)."""
+def command_without_ray(*arguments: str, sigint_ignored: bool = False) -> list[str]:
+    """The sweep command in a Python where ``import ray`` fails (the worker-process path);
+    with ``sigint_ignored``, started as a background job is (SIGINT ignored)."""
     code = (
-        "import sys\n"
-        "sys.modules['ray'] = None  # as if Ray were not installed\n"
+        "import signal, sys\n"
+        + ("signal.signal(signal.SIGINT, signal.SIG_IGN)\n" if sigint_ignored else "")
+        + "sys.modules['ray'] = None  # as if Ray were not installed\n"
         "from agents.sweep.runner import main\n"
         f"raise SystemExit(main({list(arguments)!r}))\n"
     )
+    return [sys.executable, "-c", code]
+
+
+def sweep_without_ray(*arguments: str) -> subprocess.CompletedProcess:
+    """:func:`command_without_ray` run to its end."""
     return subprocess.run(
-        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=900
+        command_without_ray(*arguments), cwd=ROOT, capture_output=True, text=True, timeout=900
     )
 
 

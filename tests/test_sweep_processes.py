@@ -8,7 +8,6 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -16,7 +15,14 @@ from typing import Any
 import pytest
 import yaml
 
-from tests.sweep_fixtures import ROOT, TINY, retrained_differences, sweep_without_ray, tiny_sweep
+from tests.sweep_fixtures import (
+    ROOT,
+    TINY,
+    command_without_ray,
+    retrained_differences,
+    sweep_without_ray,
+    tiny_sweep,
+)
 
 pytest.importorskip("stable_baselines3")
 
@@ -142,15 +148,8 @@ def test_sigterm_stops_the_sweep_and_its_workers(tmp_path: Path) -> None:
             "total_timesteps": 10_000_000,
         },
     )
-    code = (
-        "import signal, sys\n"
-        "signal.signal(signal.SIGINT, signal.SIG_IGN)  # as a background job starts\n"
-        "sys.modules['ray'] = None\n"
-        "from agents.sweep.runner import main\n"
-        f"raise SystemExit(main(['--config', {str(config)!r}, '--processes', '1']))\n"
-    )
     sweep = subprocess.Popen(
-        [sys.executable, "-c", code],
+        command_without_ray("--config", str(config), "--processes", "1", sigint_ignored=True),
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
