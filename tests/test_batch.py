@@ -150,14 +150,19 @@ def test_a_bad_process_count_names_itself(processes: Any) -> None:
 
 
 class ScriptedDecisions:
-    """A stand-in for a self-triggered model: an action that varies with the observation."""
+    """A stand-in for a self-triggered model: an action that varies with the observation;
+    with ``mostly`` that action three times in four."""
 
-    def __init__(self, n_actions: int) -> None:
+    def __init__(self, n_actions: int, mostly: int | None = None) -> None:
         self.n_actions = n_actions
+        self.mostly = mostly
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        digits = np.abs(np.asarray(observation)).sum(axis=1) * 1e4
-        return digits.astype(np.int64) % self.n_actions, None
+        digits = (np.abs(np.asarray(observation)).sum(axis=1) * 1e4).astype(np.int64)
+        actions = digits % self.n_actions
+        if self.mostly is not None:
+            actions = np.where(digits % 4 == 0, actions, self.mostly)
+        return actions, None
 
 
 def assert_same_episode(single: dict[str, Any], batch: dict[str, Any]) -> None:
@@ -192,6 +197,25 @@ def test_self_triggered_decisions_run_decision_by_decision_as_instant_by_instant
     setup.env.close()
     batch = run_batch(env_id, policy, SEEDS, env_args)
     assert len({distinct(record) for record in single}) == len(SEEDS), "scenarios must differ"
+    for one, other in zip(single, batch, strict=True):
+        assert_same_episode(one, other)
+
+
+@pytest.mark.parametrize("env_id", ["etsc/AttitudeTracking-v0", "etsc/InnerFormation-v0"])
+def test_rows_holding_one_instant_step_together_as_instant_by_instant(env_id: str) -> None:
+    """A policy that mostly holds one instant (the rows that chose it step together in the
+    vector env, the others run their intervals alone): the per-instant episodes."""
+    env_args = {"randomize": True, "horizon_s": SHORT_HORIZONS[env_id]}
+    setup = episode_setup(env_id, env_args)
+    decisions = rule_set(env_id, max_exponent=4)
+    one_instant = decisions.action("hold 1")
+    model = ScriptedDecisions(decisions.action_space.n, mostly=one_instant)
+    policy = SelfTriggeredPolicy(model, *deployment(setup, decisions))
+    single = [setup.run(setup.env, policy, seed)[0] for seed in SEEDS]
+    setup.env.close()
+    batch = run_batch(env_id, policy, SEEDS, env_args)
+    steps = single[0]["steps"]
+    assert single[0]["transmissions"] > steps / 4, "many instants must be one-instant holds"
     for one, other in zip(single, batch, strict=True):
         assert_same_episode(one, other)
 

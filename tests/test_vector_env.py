@@ -134,6 +134,40 @@ def test_reset_mask_resets_only_the_chosen_sub_envs():
     assert observations.shape == vector.observation_space.shape
 
 
+@pytest.mark.parametrize("env_id", VECTOR_IDS)
+def test_step_rows_steps_the_chosen_rows_as_their_single_envs(env_id):
+    """step_rows moves only the masked rows, each exactly as its single env's step; the other
+    rows keep their state; a row whose episode ended is refused by name."""
+    kwargs = short_kwargs(env_id)
+    vector = make_native(env_id, 3, **kwargs).unwrapped
+    singles = [gym.make(env_id, **kwargs) for _ in range(3)]
+    vector.reset(seed=[4, 5, 6])
+    for index, single in enumerate(singles):
+        single.reset(seed=4 + index)
+    masks = [np.array(mask) for mask in ([True, False, True], [False, True, False], [True] * 3)]
+    ended = np.zeros(3, dtype=bool)
+    for step, actions in enumerate(random_actions(vector.action_space, 60, seed=8)):
+        rows = masks[step % 3] & ~ended
+        if not rows.any():
+            break
+        held = vector.arrays.observation[~rows].copy()
+        observations, rewards, terminated, truncated = vector.step_rows(actions, rows)
+        assert_array_equal(observations[~rows], held, err_msg=f"held rows at step {step}")
+        assert not (terminated | truncated)[~rows].any() and not rewards[~rows].any()
+        for index in np.flatnonzero(rows):
+            single_obs, reward, single_term, single_trunc, _ = singles[index].step(actions[index])
+            assert_array_equal(observations[index], single_obs, err_msg=f"step {step}")
+            assert rewards[index] == reward, f"step {step}"
+            assert (terminated[index], truncated[index]) == (single_term, single_trunc)
+        ended |= terminated | truncated
+    assert ended.any(), "a short episode should end within 60 steps"
+    with pytest.raises(RuntimeError, match=rf"sub-environments \[{np.flatnonzero(ended)[0]}"):
+        vector.step_rows(np.zeros(vector.action_space.shape, dtype=np.int64), ended)
+    vector.close()
+    for single in singles:
+        single.close()
+
+
 def test_disabled_autoreset_refuses_to_step_a_finished_sub_env():
     env_id = "etsc/AttitudeTracking-v0"
     vector = make_native(env_id, 2, autoreset_mode="disabled", horizon_s=0.002)

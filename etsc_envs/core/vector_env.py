@@ -312,6 +312,40 @@ class EventTriggeredVectorEnv(VectorEnv):
                 )
         return steps_run
 
+    def step_rows(
+        self, actions: Any, rows: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """One sampling instant of the sub-environments ``rows`` (a boolean mask) alone, with
+        their entries of ``actions`` (:meth:`step`'s shape; the other rows' are ignored), in one
+        compiled call, for a caller that moves each row on its own schedule (self-triggered
+        decisions): each stepped row ends exactly as after its sub-environment's ``step``, the
+        others stay where they are. No autoreset and no info; ``RuntimeError`` if a stepped
+        row's episode has ended or was never reset. Returns ``(observations, rewards,
+        terminated, truncated)`` of every row (rewards 0 and both flags ``False`` for the rows
+        not stepped); :attr:`channel_rewards` holds the stepped rows' per-channel rewards."""
+        rows = np.asarray(rows, dtype=bool).reshape(self.num_envs)
+        arrays = self.arrays
+        n_steps = self.envs[0].n_steps
+        unready = rows & (
+            self._needs_reset | (arrays.failure_code != 0) | (arrays.step_index >= n_steps)
+        )
+        if unready.any():
+            raise RuntimeError(
+                f"step_rows() called on sub-environments {np.flatnonzero(unready).tolist()} "
+                "whose episode ended or was never reset; reset them first"
+            )
+        self._actions[rows] = self._transmit_bits(actions)[rows]
+        self._advance_rows(rows)
+        if self.render_mode is not None:
+            for index in np.flatnonzero(rows):
+                self.envs[index].trace_step()
+        terminated = rows & (arrays.failure_code != 0)
+        truncated = rows & ~terminated & (arrays.step_index >= n_steps)
+        self._needs_reset |= terminated | truncated
+        self.channel_rewards = np.where(rows[:, None], arrays.channel_rewards, 0.0)
+        rewards = np.where(rows, arrays.reward, 0.0)
+        return arrays.observation.copy(), rewards, terminated, truncated
+
     def render(self) -> tuple[np.ndarray | None, ...] | None:
         """One frame per sub-environment with ``render_mode="rgb_array"``, else ``None``."""
         if self.render_mode is None:

@@ -16,7 +16,8 @@ A self-triggered model (:class:`~etsc_envs.decisions.SelfTriggeredPolicy`, Gymna
 runs decision by decision instead: the model is asked once per decision for the rows still
 running, and each row's interval (a hold, or a rule deciding until it fires) runs in one
 compiled call of its own sub-environment
-(:func:`~etsc_envs.decisions.run_decision_interval`). The episode is the one the policy
+(:func:`~etsc_envs.decisions.run_decision_interval`), but for holds of one instant, which the
+rows that chose one run together in one call of the vector env. The episode is the one the policy
 gives stepped instant by instant, so every record's metrics are equal; only ``return`` may
 differ in its last bits, summed interval by interval (``tests/test_batch.py``).
 
@@ -286,13 +287,17 @@ def _run_decisions(
     description: str,
 ) -> list[dict[str, Any]]:
     """Every row's episode from ``observations`` (just after the reset) decision by decision:
-    one batched choice of the model for the rows still running, then each row's interval in one
-    compiled call of its own sub-environment
-    (:func:`~etsc_envs.decisions.run_decision_interval`), the episode
-    :class:`~etsc_envs.decisions.SelfTriggeredPolicy` runs instant by instant. Adds each
-    row's return to ``returns`` and returns each row's episode metrics."""
+    one batched choice of the model for the rows still running, then each row's interval, the
+    episode :class:`~etsc_envs.decisions.SelfTriggeredPolicy` runs instant by instant. The
+    rows that chose a hold of one instant step together in one compiled call
+    (:meth:`~etsc_envs.core.vector_env.EventTriggeredVectorEnv.step_rows`); every other row
+    runs its interval in one compiled call of its own sub-environment
+    (:func:`~etsc_envs.decisions.run_decision_interval`). Adds each row's return to
+    ``returns`` and returns each row's episode metrics."""
     rows = vector_env.num_envs
     loops = vector_env.envs
+    schedule = policy.schedule
+    one_instant = schedule.is_hold & (schedule.lengths == 1)
     observations = np.array(observations)
     running = np.ones(rows, dtype=bool)
     ended_metrics: list[dict[str, Any]] = [{} for _ in range(rows)]
@@ -301,13 +306,30 @@ def _run_decisions(
         while running.any():
             deciding = np.flatnonzero(running)
             actions = policy.choose(observations[deciding])
+            stepped = np.zeros(rows, dtype=bool)
+            stepped[deciding[one_instant[actions]]] = True
+            if stepped.any():
+                chosen = actions[one_instant[actions]]
+                decision, _ = schedule.transmit(observations[stepped], schedule.start(chosen))
+                bits = np.zeros((rows, loops[0].n_channels), dtype=np.int64)
+                bits[stepped] = decision.reshape(len(chosen), -1)
+                stepped_observations, rewards, terminated, truncated = vector_env.step_rows(
+                    bits, stepped
+                )
+                observations[stepped] = stepped_observations[stepped]
+                returns[stepped, 0] += rewards[stepped]
+                for row in np.flatnonzero(terminated | truncated):
+                    running[row] = False
+                    ended_metrics[row] = loops[row].episode_metrics()
             for row, action in zip(deciding, actions, strict=True):
-                observation, total, terminated, truncated, _, _ = run_decision_interval(
-                    loops[row], policy.schedule, int(action), observations[row]
+                if stepped[row]:
+                    continue
+                observation, total, terminated_row, truncated_row, _, _ = run_decision_interval(
+                    loops[row], schedule, int(action), observations[row]
                 )
                 observations[row] = observation
                 returns[row, 0] += total
-                if terminated or truncated:
+                if terminated_row or truncated_row:
                     running[row] = False
                     ended_metrics[row] = loops[row].episode_metrics()
             if progress:
