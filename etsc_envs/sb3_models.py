@@ -18,6 +18,7 @@ import io
 import json
 import pickletools
 import zipfile
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from pathlib import Path
 from types import ModuleType
@@ -470,6 +471,101 @@ class ObservationStatistics:
         return normalization
 
 
+GreedyActor = Callable[[np.ndarray, "np.ndarray | None"], np.ndarray]
+"""Observations (and action masks, or ``None``) -> the model's deterministic actions."""
+
+
+def greedy_actor(model: Any) -> GreedyActor | None:
+    """``model.predict(observation, deterministic=True, [action_masks])``'s actions, computed
+        without Stable-Baselines3's distribution objects, or ``None`` for a model it does not cover.
+
+    Covered, over ``Box`` observations: PPO and MaskablePPO policies of the actor-critic family
+        whose action distribution is categorical (``Discrete``, masked or not) or Bernoulli
+        (``MultiBinary``), and DQN. The same modules run in the same order on the same tensors
+        (features, actor latent, logits; Q-values for DQN), and the mode is taken as the
+        distribution takes it (torch's ``logits_to_probs`` of the normalised logits, masked ones
+        set to sb3-contrib's -1e8, then the argmax; ``round(sigmoid)`` for Bernoulli), so the
+        actions are SB3's bit for bit (``tests/test_greedy_actor.py``). Building and validating the
+        distribution object, and finding the device at every call, were two thirds of a batched
+        ``predict``'s time. Recurrent policies, and any other class whose ``get_distribution`` is
+        not the one read here, are not covered.
+    """
+    import torch
+    from stable_baselines3.common.distributions import (
+        BernoulliDistribution,
+        CategoricalDistribution,
+    )
+    from stable_baselines3.common.policies import ActorCriticPolicy, BaseModel
+    from stable_baselines3.dqn.policies import DQNPolicy
+    from torch.distributions.utils import logits_to_probs
+
+    policy: Any = getattr(model, "policy", None)
+    kind = type(policy)
+    if not isinstance(getattr(policy, "observation_space", None), gym.spaces.Box):
+        return None
+    if issubclass(kind, DQNPolicy) and kind._predict is DQNPolicy._predict:
+
+        def q_values(obs: Any, masks: np.ndarray | None) -> Any:
+            return policy._predict(obs, deterministic=True)
+
+        return _greedy(policy, q_values, torch)
+    families: dict[type, Any] = {ActorCriticPolicy: ActorCriticPolicy.get_distribution}
+    masked_distribution: type | None = None
+    try:
+        from sb3_contrib.common.maskable.distributions import MaskableCategoricalDistribution
+        from sb3_contrib.common.maskable.policies import MaskableActorCriticPolicy
+
+        families[MaskableActorCriticPolicy] = MaskableActorCriticPolicy.get_distribution
+        masked_distribution = MaskableCategoricalDistribution
+    except ImportError:  # sb3-contrib not installed: SB3's policies only
+        pass
+    if not issubclass(kind, tuple(families)) or getattr(kind, "get_distribution", None) not in set(
+        families.values()
+    ):
+        return None
+    distribution = type(policy.action_dist)
+    categorical = distribution in (CategoricalDistribution, masked_distribution)
+    if not (categorical or distribution is BernoulliDistribution):
+        return None
+
+    def mode(obs: Any, masks: np.ndarray | None) -> Any:
+        features = BaseModel.extract_features(policy, obs, policy.pi_features_extractor)
+        logits = policy.action_net(policy.mlp_extractor.forward_actor(features))
+        if not categorical:
+            return torch.round(logits_to_probs(logits, is_binary=True))
+        if masks is not None:
+            allowed = torch.as_tensor(masks, dtype=torch.bool).reshape(logits.shape)
+            logits = torch.where(allowed, logits, torch.tensor(-1e8, dtype=logits.dtype))
+        normalized = logits - logits.logsumexp(dim=-1, keepdim=True)
+        return torch.argmax(logits_to_probs(normalized), dim=1)
+
+    return _greedy(policy, mode, torch)
+
+
+def _greedy(policy: Any, actions_of: Callable[..., Any], torch: ModuleType) -> GreedyActor:
+    """What ``policy.predict`` does around its ``_predict`` (evaluation mode, the observation
+    as a tensor on the policy's device, the actions reshaped to the action space, a single
+    observation unbatched), with ``actions_of(obs_tensor, masks)`` in its place. The device is
+    read once (SB3 reads it from the parameters at every call)."""
+    from stable_baselines3.common.utils import is_vectorized_observation
+
+    device = policy.device
+    space = policy.observation_space
+
+    def act(observation: np.ndarray, masks: np.ndarray | None) -> np.ndarray:
+        if policy.training:
+            policy.set_training_mode(False)
+        observation = np.asarray(observation)
+        vectorized = is_vectorized_observation(observation, space)
+        obs = torch.as_tensor(observation.reshape((-1, *space.shape)), device=device)
+        with torch.no_grad():
+            chosen = actions_of(obs, masks)
+        actions = chosen.cpu().numpy().reshape((-1, *policy.action_space.shape))
+        return actions if vectorized else actions.squeeze(axis=0)
+
+    return act
+
+
 class NormalizedModel:
     """A Stable-Baselines3 model that reads observations through ``VecNormalize`` statistics
     (``predict`` never updates them).
@@ -489,6 +585,8 @@ class NormalizedModel:
             self.normalization.training = False
         self.observation_space = model.observation_space
         self.action_space = model.action_space
+        self.greedy = greedy_actor(model)
+        """:func:`greedy_actor` of the model (``None`` where SB3's ``predict`` answers)."""
 
     def predict(
         self,
@@ -499,8 +597,11 @@ class NormalizedModel:
         action_masks: np.ndarray | None = None,
     ) -> tuple[np.ndarray, Any]:
         """The model's ``predict`` on normalised observations (``action_masks`` is passed on
-        when given, for sb3-contrib's ``MaskablePPO``)."""
+        when given, for sb3-contrib's ``MaskablePPO``); its deterministic actions by
+        :attr:`greedy` where it covers the model."""
         normalized = self.normalization.normalize_obs(np.asarray(observation, dtype=np.float32))
+        if deterministic and state is None and self.greedy is not None:
+            return self.greedy(normalized, action_masks), state
         masks = {} if action_masks is None else {"action_masks": action_masks}
         return self.model.predict(
             normalized,
