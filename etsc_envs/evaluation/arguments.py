@@ -62,10 +62,11 @@ def model_spec(model: str) -> str:
 
 
 def write_json(payload: dict[str, Any], destination: str) -> None:
-    """Write ``payload`` as JSON to a file (whole or not at all), or to standard output for
+    """Write ``payload`` as JSON to a file, compact (records of a test set run to megabytes:
+    indentation doubled them) and whole or not at all, or indented to standard output for
     ``-``."""
-    text = json.dumps(to_jsonable(payload), indent=2)
+    payload = to_jsonable(payload)
     if destination == "-":
-        sys.stdout.write(text + "\n")
+        sys.stdout.write(json.dumps(payload, indent=2) + "\n")
     else:
-        atomic_write_text(destination, text + "\n")
+        atomic_write_text(destination, json.dumps(payload, separators=(",", ":")) + "\n")
