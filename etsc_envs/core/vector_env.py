@@ -316,8 +316,8 @@ class EventTriggeredVectorEnv(VectorEnv):
         self, actions: Any, rows: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """One sampling instant of the sub-environments ``rows`` (a boolean mask) alone, with
-        their entries of ``actions`` (:meth:`step`'s shape; the other rows' are ignored), in one
-        compiled call, for a caller that moves each row on its own schedule (self-triggered
+        their entries of ``actions`` (:meth:`step`'s shape; the other rows' are ignored), compiled,
+        on the calling thread, for a caller that moves each row on its own schedule (self-triggered
         decisions): each stepped row ends exactly as after its sub-environment's ``step``, the
         others stay where they are. No autoreset and no info; ``RuntimeError`` if a stepped
         row's episode has ended or was never reset. Returns ``(observations, rewards,
@@ -335,7 +335,7 @@ class EventTriggeredVectorEnv(VectorEnv):
                 "whose episode ended or was never reset; reset them first"
             )
         self._actions[rows] = self._transmit_bits(actions)[rows]
-        self._advance_rows(rows)
+        self._advance_rows(rows, threaded=False)
         if self.render_mode is not None:
             for index in np.flatnonzero(rows):
                 self.envs[index].trace_step()
@@ -362,8 +362,10 @@ class EventTriggeredVectorEnv(VectorEnv):
             env.close()
 
     # ----------------------------------------------------------------- internals
-    def _advance_rows(self, active: np.ndarray) -> None:
-        """One compiled loop step of the ``active`` rows, each thread on its own row range."""
+    def _advance_rows(self, active: np.ndarray, threaded: bool = True) -> None:
+        """One compiled loop step of the ``active`` rows, each thread on its own row range
+        (all ranges on this thread unless ``threaded``: for a few rows of the batch, the
+        hand-off to the stepping threads costs more than it saves)."""
         first = self.envs[0]
 
         def arguments(chunk: int) -> tuple[Any, ...]:
@@ -384,7 +386,11 @@ class EventTriggeredVectorEnv(VectorEnv):
             self._loop_step_entry = compiled_entry(first.loop_step, *arguments(0))
         entry = self._loop_step_entry
 
-        self._run_chunks(lambda chunk: entry(*arguments(chunk)))
+        if threaded:
+            self._run_chunks(lambda chunk: entry(*arguments(chunk)))
+        else:
+            for chunk in range(len(self._chunks)):
+                entry(*arguments(chunk))
 
     def _run_chunks(self, work: Any) -> None:
         """``work(chunk)`` for every row range, each on its own stepping thread."""
