@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import subprocess
 from typing import Any
 
@@ -41,3 +42,40 @@ def test_protocol_defaults_to_the_paper_trigger() -> None:
         "paper",
         [],
     )
+
+
+@pytest.mark.parametrize(
+    ("module", "argv", "message"),
+    [
+        (
+            "judging",
+            ["etsc/AttitudeTracking-v0", "--model", "m.zip", "--set-size", "0"],
+            "--set-size",
+        ),
+        (
+            "judging",
+            ["etsc/AttitudeTracking-v0", "--model", "m.zip", "--repeats", "0"],
+            "--repeats",
+        ),
+        ("judging", ["etsc/Nope-v0", "--model", "m.zip"], "etsc/Nope-v0"),
+        ("judging", ["etsc/AttitudeTracking-v0", "--model", "m.zip"], "m.zip"),
+        (
+            "judging",
+            ["etsc/AttitudeTracking-v0", "--model", "models/AttitudeTracking-v0_ppo.zip"],
+            "does not take self-triggered decisions",
+        ),
+        ("decisions", ["--repeats", "0"], "--repeats"),
+        ("decisions", ["--env", "etsc/Nope-v0"], "etsc/Nope-v0"),
+        ("search", ["--generations", "0"], "--generations"),
+    ],
+)
+def test_bench_commands_refuse_bad_input_in_one_line(
+    module: str, argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Each ``agents.bench`` command names the argument and exits 2 before timing anything."""
+    bench = importlib.import_module(f"agents.bench.{module}")
+    with pytest.raises(SystemExit) as exit_info:
+        bench.main(argv)
+    assert exit_info.value.code == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert error.startswith(f"python -m agents.bench.{module}: error:") and message in error

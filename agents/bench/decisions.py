@@ -22,7 +22,7 @@ import time
 import gymnasium as gym
 import numpy as np
 
-import etsc_envs  # noqa: F401  (registers the ids)
+import etsc_envs
 from etsc_envs.decisions import DecisionSet, Hold, SelfTriggeredWrapper, TriggerAction
 from etsc_envs.triggers.family import FamilyPoint
 
@@ -107,13 +107,22 @@ def summary(values: list[float]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m agents.bench.decisions", description=(__doc__ or "").split("\n\n")[0]
+    )
     parser.add_argument("--env", nargs="+", default=list(DEFAULT_IDS), help="Gymnasium ids")
     parser.add_argument("--repeats", type=int, default=5, help="timed runs per figure")
     parser.add_argument(
         "--per-instant", action="store_true", help="one env.step per instant (no compiled holds)"
     )
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be an integer >= 1, got {args.repeats}")
+    unknown = [env_id for env_id in args.env if env_id not in etsc_envs.ENV_IDS]
+    if unknown:
+        parser.error(
+            f"--env: {unknown} are not Gymnasium ids of the suite {sorted(etsc_envs.ENV_IDS)}"
+        )
     for env_id in args.env:
         for policy in DECISIONS:
             record = rates(env_id, policy, args.repeats, args.per_instant)

@@ -20,6 +20,8 @@ import statistics
 import time
 from typing import Any
 
+from etsc_envs.cli import positive_integer
+from etsc_envs.decisions import SelfTriggeredPolicy
 from etsc_envs.evaluation.arguments import limit_torch_threads
 from etsc_envs.evaluation.batch import run_batch
 from etsc_envs.evaluation.policy_specs import episode_setup
@@ -47,18 +49,32 @@ def timed(
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m agents.bench.judging", description=(__doc__ or "").split("\n\n")[0]
+    )
     parser.add_argument("env_id", help="a Gymnasium id of the suite")
     parser.add_argument("--model", required=True, help="a self-triggered SB3 zip")
-    parser.add_argument("--set-size", type=int, default=8, help="test scenarios (default 8)")
+    parser.add_argument(
+        "--set-size", type=positive_integer, default=8, help="test scenarios (default 8)"
+    )
     parser.add_argument("--repeats", type=int, default=3, help="timed runs of each path")
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be an integer >= 1, got {args.repeats}")
     limit_torch_threads()
-    scenarios = scenario_set("test", args.set_size)
-    env_kwargs = scenarios.env_kwargs({})
-    setup = episode_setup(args.env_id, env_kwargs)
-    policy = setup.make_policy(f"sb3:{args.model}", {})
-    setup.env.close()
+    try:  # the id, the set and the model are checked before anything is timed
+        scenarios = scenario_set("test", args.set_size)
+        env_kwargs = scenarios.env_kwargs({})
+        setup = episode_setup(args.env_id, env_kwargs)
+        policy = setup.make_policy(f"sb3:{args.model}", {})
+        setup.env.close()
+    except ValueError as error:
+        parser.error(str(error))
+    if not isinstance(policy, SelfTriggeredPolicy):
+        parser.error(
+            f"--model: {args.model} does not take self-triggered decisions on {args.env_id} "
+            "(a model saved with its decision set, on a Gymnasium id)"
+        )
     seeds = list(scenarios.seeds)
     runners = {"decision by decision": policy, "instant by instant": PerInstant(policy)}
     times: dict[str, list[float]] = {name: [] for name in runners}
