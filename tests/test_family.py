@@ -219,6 +219,97 @@ def test_kernel_decisions_equal_predict_and_the_python_model() -> None:
     assert batch[0]["transmissions"] == predicted
 
 
+def _cluster_points(seed: int) -> tuple[Modulation, FamilyPoint]:
+    """A random network per channel on 001's followers (each its own ‖s‖ and ‖e_s‖) and a
+    plain point to put it in."""
+    rng = np.random.default_rng(seed)
+    per_channel = Modulation.zeros(
+        ("s_norm{channel}", "e_s_norm{channel}"),
+        np.array([0.02, 0.0]),
+        np.array([0.002, 0.001]),  # the followers' ‖s‖ differ by about 0.004
+        hidden=3,
+    )
+    per_channel = per_channel.with_weights(rng.normal(size=per_channel.weights.size))
+    point = FamilyPoint(factors={"c": 1.5}, floor_instants=2, heartbeat_instants=300)
+    return per_channel, point
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_network_per_channel_is_each_channels_own_network(seed: int) -> None:
+    """Channel c of a per-channel network decides as a network for every channel reading
+    channel c's inputs would (the same weights), on the observations of a cluster episode; an
+    agent of the PettingZoo form, reading its own unsuffixed observation, decides as its
+    channel of the central form."""
+    import etsc_envs
+
+    env = gym.make("etsc/ClusterContainmentCentral-v0", horizon_s=30.0, randomize=True)
+    loop = env.unwrapped
+    names = loop.observation_names
+    family = family_trigger_class(ClusterContainmentTrigger)
+    per_channel, point = _cluster_points(seed)
+
+    def trigger(modulation: Modulation, space=env.observation_space, action=env.action_space):
+        return family(space, action, names, replace(point, modulation=modulation), 0.01)
+
+    own = trigger(per_channel)
+    shared = [
+        trigger(replace(per_channel, inputs=per_channel.channel_inputs(c)))
+        for c in range(loop.n_channels)
+    ]
+    parallel = etsc_envs.make_parallel("etsc/ClusterContainment-v0")
+    agent_names = parallel.unwrapped.agent_observation_names
+    agent = family(
+        parallel.observation_space(parallel.possible_agents[0]),
+        parallel.action_space(parallel.possible_agents[0]),
+        agent_names,
+        replace(point, modulation=per_channel),
+        0.01,
+    )
+    agent_columns = [
+        [names.index(f"{name}_{c}") for name in agent_names] for c in range(loop.n_channels)
+    ]
+    obs, _ = env.reset(seed=3)
+    decisions = np.zeros(loop.n_channels, dtype=int)
+    differs = 0
+    for _ in range(3000):
+        action, _ = own.predict(obs)
+        for c, network in enumerate(shared):
+            assert action[c] == network.predict(obs)[0][c]
+            assert action[c] == agent.predict(obs[agent_columns[c]])[0]
+        decisions += action
+        differs += int(len({tuple(network.predict(obs)[0]) for network in shared}) > 1)
+        obs, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            break
+    assert decisions.sum() > 0 and differs > 0, "the channels' networks must disagree somewhere"
+    parallel.close()
+    env.close()
+
+
+def test_a_network_per_channel_round_trips_and_is_refused_where_it_cannot_act(tmp_path) -> None:
+    """A per-channel network survives its learned file; braces other than {channel}, inputs
+    a layout lacks and a per-channel network on a coupled point are refused by name."""
+    per_channel, point = _cluster_points(0)
+    point = replace(point, modulation=per_channel)
+    path = tmp_path / "learned.json"
+    family = "ClusterContainmentTrigger"
+    LearnedTrigger("etsc/ClusterContainmentCentral-v0", family, point).save(path)
+    loaded = LearnedTrigger.load(path)
+    assert loaded.point.modulation.per_channel and loaded.point.to_json() == point.to_json()
+    with pytest.raises(ValueError, match=r"'s_norm\{agent\}' holds braces other than"):
+        replace(per_channel, inputs=("s_norm{agent}", "e_s_norm{channel}"))
+    env = gym.make("etsc/InnerFormation-v0")
+    names = env.unwrapped.observation_names
+    make = family_trigger_class(InnerFormationTrigger)
+    network = Modulation.zeros(("r{channel}",), np.zeros(1), np.ones(1), hidden=2)
+    with pytest.raises(ValueError, match=r"modulation.inputs \['r_0', 'r_1', 'r_2'\] are not"):
+        make(env.observation_space, env.action_space, names, FamilyPoint(modulation=network), 0.1)
+    axes = Modulation.zeros(("time_since_transmission_s{channel}",), np.zeros(1), np.ones(1), 2)
+    coupled = FamilyPoint(modulation=axes, coupling=Coupling((1.0, 1.0, 1.0)))
+    with pytest.raises(ValueError, match="cannot steer a coupled point"):
+        make(env.observation_space, env.action_space, names, coupled, 0.1)
+
+
 def _coupled_trigger(env: gym.Env, point: FamilyPoint):
     loop = env.unwrapped
     family = family_trigger_class(InnerFormationTrigger)

@@ -187,8 +187,31 @@ def test_training_seeds_avoid_the_protocols_sets() -> None:
         ({"horizon_s": 0}, "horizon_s"),
         ({"search": ["modulation"]}, "inputs"),
         (
-            {"env_id": "etsc/ClusterContainment-v0", "start": {}, "search": ["modulation"]},
-            "cannot be searched on etsc/ClusterContainment-v0",
+            {
+                "env_id": "etsc/ClusterContainment-v0",
+                "start": {},
+                "search": ["modulation"],
+                "inputs": ["s_norm"],
+            },
+            r"inputs\[0\]': 's_norm' must read each agent's own observation",
+        ),
+        (
+            {
+                "env_id": "etsc/ClusterContainment-v0",
+                "start": {},
+                "search": ["modulation"],
+                "inputs": ["s_norm_{channel}"],
+            },
+            r"\['s_norm_'\] are not observations of etsc/ClusterContainment-v0",
+        ),
+        (
+            {
+                "env_id": "etsc/ClusterContainmentCentral-v0",
+                "start": {},
+                "search": ["modulation"],
+                "inputs": ["s_norm{channel}", "speed{channel}"],
+            },
+            r"inputs\[1\]': \['speed_0', .* are not observations",
         ),
         ({"colour": "red"}, "unknown keys"),
         ({"start": {"factors": {"psi": 0.0}}}, "factors.psi"),

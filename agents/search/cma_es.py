@@ -76,6 +76,7 @@ from etsc_envs.core.validation import MAX_TRANSMISSION_PENALTY
 from etsc_envs.papers import PAPER_IDS, paper_of
 from etsc_envs.protocol import require_training_seeds, scenario_set
 from etsc_envs.triggers.family import (
+    CHANNEL,
     MAX_EXPONENT,
     MAX_HIDDEN,
     FamilyPoint,
@@ -219,17 +220,11 @@ def _checked_config(raw: dict[str, Any]) -> SearchConfig:
             f"got {start.exponent!r}"
         )
     names = _observation_names(env_id, horizon_s)
-    inputs = require_strings(raw.get("inputs", []), "search.inputs", names)
+    inputs = _inputs(env_id, raw.get("inputs", []), names)
     if "coupling" in search and start.coupling is None:
         raise ValueError(
             "key 'search.start.coupling' gives the coupling a search of coupling starts from "
             "(e.g. {weights: [1, 1, 1], strength: 0} on 004's three axes)"
-        )
-    if "modulation" in search and env_id in etsc_envs.PETTINGZOO_ENV_IDS:
-        raise ValueError(
-            f"key 'search.search': the network ('modulation') cannot be searched on {env_id}: "
-            "the family kernel reads one set of inputs for every channel, where each agent would "
-            "need its own follower's; search its central id instead"
         )
     if ("modulation" in search) != bool(inputs):
         raise ValueError(
@@ -278,6 +273,32 @@ def _observation_names(env_id: str, horizon_s: float | None) -> tuple[str, ...]:
         names = tuple(parallel.unwrapped.agent_observation_names)
         parallel.close()
     return names
+
+
+def _inputs(env_id: str, value: Any, names: tuple[str, ...]) -> tuple[str, ...]:
+    """``search.inputs``: observation names of one agent of ``env_id`` (``names``), each
+    holding :data:`~etsc_envs.triggers.family.CHANNEL` where every channel reads its own
+    (``s_norm{channel}``); on a PettingZoo id every input must, since an agent observes only
+    its own follower."""
+    inputs = require_strings(value, "search.inputs")
+    pettingzoo = env_id in etsc_envs.PETTINGZOO_ENV_IDS
+    channels = sum(name.startswith("time_since_transmission_s") for name in names)
+    for index, name in enumerate(inputs):
+        if pettingzoo and CHANNEL not in name:
+            raise ValueError(
+                f"key 'search.inputs[{index}]': {name!r} must read each agent's own observation "
+                f"on {env_id} (an input such as 's_norm{CHANNEL}')"
+            )
+        if CHANNEL not in name or pettingzoo:
+            expanded = [name.replace(CHANNEL, "")]
+        else:
+            expanded = [name.replace(CHANNEL, f"_{c}") for c in range(channels)]
+        missing = [entry for entry in expanded if entry not in names]
+        if missing:
+            raise ValueError(
+                f"key 'search.inputs[{index}]': {missing} are not observations of {env_id}"
+            )
+    return inputs
 
 
 def _integer(key: str, value: Any, least: int) -> int:
@@ -469,17 +490,24 @@ def training_seeds(config: SearchConfig, generation: int) -> list[int]:
 
 def observation_statistics(config: SearchConfig) -> tuple[np.ndarray, np.ndarray]:
     """Mean and spread of the network's inputs over two training episodes of the start point
-    (the normalisation the learned file carries); a constant input gets spread 1."""
-    env = gym.make(config.env_id, randomize=True, **config.env_args(training=True))
-    names = env.unwrapped.observation_names
-    trigger = LearnedTrigger(config.env_id, config.family.__name__, config.start).policy_for(env)
-    columns = [names.index(name) for name in config.inputs]
+    in the id's closed loop (the normalisation the learned file carries; a per-channel input
+    pooled over the channels); a constant input gets spread 1."""
+    loop_id = etsc_envs.PETTINGZOO_LOOP_IDS.get(config.env_id, config.env_id)
+    env = gym.make(loop_id, randomize=True, **config.env_args(training=True))
+    loop = env.unwrapped
+    names = tuple(loop.observation_names)
+    trigger = _learned(config, config.start, {}).trigger(
+        env.observation_space, env.action_space, names, loop.sampling_period_s
+    )
+    n_inputs = len(config.inputs)
+    zeros = Modulation.zeros(config.inputs, np.zeros(n_inputs), np.ones(n_inputs), config.hidden)
+    columns = zeros.input_columns(names, loop.n_channels)
     rows = []
     for seed in training_seeds(config, 0)[:2]:
         obs, _ = env.reset(seed=seed)
         done = False
         while not done:
-            rows.append(obs[columns])
+            rows.extend(obs[own] for own in columns)
             action, _ = trigger.predict(obs)
             obs, _, terminated, truncated, _ = env.step(action)
             done = terminated or truncated

@@ -15,7 +15,8 @@ transmits when
 
 where p is a time exponent, τ_ref the family's reference time (:data:`REFERENCE_S`), and
 ``g = (g_h, g_min, g_max)`` the output of a small state-dependent network (two tanh layers on
-the normalised observation, :class:`Modulation`), zero when it has no weights. The weighting
+the normalised observation, :class:`Modulation`; one for all channels, or one per channel on
+that channel's own inputs), zero when it has no weights. The weighting
 is applied to both sides so that every named point is its stand-alone policy's comparison to
 the last bit: with p = 0 and g = 0 both factors are exactly 1.
 
@@ -105,6 +106,13 @@ changes the thresholds little near it. 004's 0.05 s makes p = 1 the error-time r
 default areas (Π_i × 0.05 s, :data:`~etsc_envs.triggers.inner_formation.ERROR_TIME_REFERENCE_S`)."""
 
 
+CHANNEL = "{channel}"
+"""The placeholder of a per-channel input name (``s_norm{channel}``): channel c reads the name
+with the suffix ``_c`` in its place (``s_norm_0`` … ``s_norm_5`` on paper 001's central
+form), or with nothing where the trigger serves one agent whose observation names are
+unsuffixed (``s_norm``, an agent of the PettingZoo form), the layouts of the paper triggers."""
+
+
 @dataclass(frozen=True)
 class Modulation:
     """The state-dependent part of θ: ``g = clip(W3 tanh(W2 tanh(W1 x + b1) + b2) + b3)``
@@ -112,7 +120,11 @@ class Modulation:
 
     ``inputs`` are observation names; the arrays are the layers' weights (``W1`` of shape
     ``(h1, len(inputs))``, ``W2`` ``(h2, h1)``, ``W3`` ``(3, h2)``). All-zero weights give
-    g = 0, the plain family.
+    g = 0, the plain family. Where a name holds :data:`CHANNEL` the network is **per
+    channel**: the same weights evaluated once for each channel on that channel's inputs (its
+    own follower's ‖s‖ on paper 001), each channel's g scaling its own threshold, floor and
+    heartbeat, as one policy shared by the agents of a PettingZoo id reads each agent's own
+    observation; names without it are read by every channel alike.
     """
 
     inputs: tuple[str, ...]
@@ -126,6 +138,12 @@ class Modulation:
     b3: np.ndarray
 
     def __post_init__(self) -> None:
+        for name in self.inputs:
+            if "{" in name.replace(CHANNEL, "") or "}" in name.replace(CHANNEL, ""):
+                raise ValueError(
+                    f"modulation.inputs: {name!r} holds braces other than {CHANNEL}, the only "
+                    "placeholder of an input name"
+                )
         for name in ("b1", "b2"):
             bias = np.asarray(getattr(self, name), dtype=np.float64)
             if bias.ndim != 1 or not 1 <= bias.size <= MAX_HIDDEN:
@@ -178,6 +196,31 @@ class Modulation:
     @property
     def hidden(self) -> tuple[int, int]:
         return len(self.b1), len(self.b2)
+
+    @property
+    def per_channel(self) -> bool:
+        """Whether each channel evaluates the network on its own inputs (:data:`CHANNEL`)."""
+        return any(CHANNEL in name for name in self.inputs)
+
+    def channel_inputs(self, channel: int | None) -> tuple[str, ...]:
+        """The observation names channel ``channel`` reads (``None``: the one channel of an
+        agent's unsuffixed observation; see :data:`CHANNEL`)."""
+        suffix = "" if channel is None else f"_{channel}"
+        return tuple(name.replace(CHANNEL, suffix) for name in self.inputs)
+
+    def input_columns(self, names: tuple[str, ...], channels: int) -> list[list[int]]:
+        """The columns of an observation with these names that the network reads: one set
+        per channel for a per-channel network on ``channels`` channels, else one set;
+        ``ValueError`` naming the inputs that are not observations here."""
+        unsuffixed = self.channel_inputs(None)
+        if not self.per_channel or (channels == 1 and all(n in names for n in unsuffixed)):
+            sets = [unsuffixed]  # every channel's inputs, or one agent's own observation
+        else:
+            sets = [self.channel_inputs(c) for c in range(channels)]
+        missing = [name for inputs in sets for name in inputs if name not in names]
+        if missing:
+            raise ValueError(f"modulation.inputs {missing} are not observations here")
+        return [[names.index(name) for name in inputs] for inputs in sets]
 
     @property
     def weights(self) -> np.ndarray:
@@ -430,6 +473,28 @@ def dense_layer(parameters, offset, inputs, out, squash):
 
 
 @jit
+def modulation_outputs(observation, indices, parameters, first_input, n_inputs, q, h1, h2):
+    """The network's clipped outputs ``g = (g_h, g_min, g_max)`` on the observation entries
+    ``indices[first_input : first_input + n_inputs]``, its parameters (mean, scale, W1, b1,
+    W2, b2, W3, b3) read from ``parameters`` at ``q``."""
+    x = np.empty(n_inputs)
+    for i in range(n_inputs):
+        x[i] = (float(observation[indices[first_input + i]]) - parameters[q + i]) / (
+            parameters[q + n_inputs + i]
+        )
+    q += 2 * n_inputs
+    hidden1 = np.empty(h1)
+    q = dense_layer(parameters, q, x, hidden1, True)
+    hidden2 = np.empty(h2)
+    q = dense_layer(parameters, q, hidden1, hidden2, True)
+    g = np.empty(3)
+    dense_layer(parameters, q, hidden2, g, False)
+    for j in range(3):
+        g[j] = min(max(g[j], -MODULATION_BOUND), MODULATION_BOUND)
+    return g
+
+
+@jit
 def coupled_send(observation, time_indices, coupling, statistic, threshold, limits, strict, out):
     """A coupled point's decision (the module docstring) into ``out``; ``coupling`` holds 1, κ,
     refresh-all (1 or 0) and the conditions' weights, ``limits`` the floor, heartbeat and
@@ -477,44 +542,36 @@ def family_rule(
     (the module docstring's decision), over the paper's ``condition`` kernel.
 
     ``indices`` holds the paper's indices, then the C channels' time-since-transmission
-    indices, then the network's input indices, then five counts: the paper's indices, the
-    paper's parameters, the inputs, and the two hidden widths (0 for no network).
+    indices, then the network's input indices (one set read by every channel, or C sets,
+    channel-major, each channel's network reading its own), then six counts: the paper's
+    indices, the paper's parameters, the input sets (1 or C), the inputs of a set, and the two
+    hidden widths (0 for no network).
     ``parameters`` holds the paper's (thresholds already scaled), then τ_min, τ_max, p,
     τ_ref, τ_first (s), then 1 for a coupled point (else 0), κ, 1 to refresh all channels
     (else 0) and the weights of the C × J conditions, then the network's mean, scale, W1, b1,
-    W2, b2, W3, b3.
+    W2, b2, W3, b3 (one network, whichever set it reads).
     """
 
     @closure_jit
     def rule(observation, indices, parameters, out):
         m = indices.shape[0]
-        n_rule_indices = indices[m - 5]
-        p0 = indices[m - 4]
+        n_rule_indices = indices[m - 6]
+        p0 = indices[m - 5]
+        input_sets = indices[m - 4]
         n_inputs = indices[m - 3]
         h1 = indices[m - 2]
         h2 = indices[m - 1]
         channels = out.shape[0]
         n_conditions = channels * conditions_per_channel
+        network_start = p0 + 8 + n_conditions
+        first_input = n_rule_indices + channels
         g_threshold = 0.0
         g_floor = 0.0
         g_heartbeat = 0.0
-        if h1 > 0:
-            q = p0 + 8 + n_conditions
-            first_input = n_rule_indices + channels
-            x = np.empty(n_inputs)
-            for i in range(n_inputs):
-                x[i] = (float(observation[indices[first_input + i]]) - parameters[q + i]) / (
-                    parameters[q + n_inputs + i]
-                )
-            q += 2 * n_inputs
-            hidden1 = np.empty(h1)
-            q = dense_layer(parameters, q, x, hidden1, True)
-            hidden2 = np.empty(h2)
-            q = dense_layer(parameters, q, hidden1, hidden2, True)
-            g = np.empty(3)
-            dense_layer(parameters, q, hidden2, g, False)
-            for j in range(3):
-                g[j] = min(max(g[j], -MODULATION_BOUND), MODULATION_BOUND)
+        if h1 > 0 and input_sets == 1:
+            g = modulation_outputs(
+                observation, indices, parameters, first_input, n_inputs, network_start, h1, h2
+            )
             g_threshold = g[0]
             g_floor = g[1]
             g_heartbeat = g[2]
@@ -540,6 +597,20 @@ def family_rule(
             return
         for channel in range(channels):
             elapsed = float(observation[indices[n_rule_indices + channel]])
+            if h1 > 0 and input_sets > 1:  # this channel's network on its own inputs
+                g = modulation_outputs(
+                    observation,
+                    indices,
+                    parameters,
+                    first_input + channel * n_inputs,
+                    n_inputs,
+                    network_start,
+                    h1,
+                    h2,
+                )
+                floor_s = parameters[p0] * np.exp(g[1])
+                heartbeat_s = parameters[p0 + 1] * np.exp(g[2])
+                threshold_scale = np.exp(g[0]) * parameters[p0 + 3] ** exponent
             fires = 0
             if elapsed < first_s or elapsed >= heartbeat_s:
                 fires = 1
@@ -669,12 +740,16 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
             if modulation is None:
                 inputs: list[int] = []
                 network: list[float] = []
-                hidden = (0, 0)
+                input_sets, n_inputs, hidden = 1, 0, (0, 0)
             else:
-                missing = [name for name in modulation.inputs if name not in names]
-                if missing:
-                    raise ValueError(f"modulation.inputs {missing} are not observations here")
-                inputs = [names.index(name) for name in modulation.inputs]
+                columns = modulation.input_columns(names, channels)
+                if len(columns) > 1 and coupling is not None:
+                    raise ValueError(
+                        f"point.modulation: a network per channel ({CHANNEL} in its inputs) "
+                        "cannot steer a coupled point, whose channels decide together"
+                    )
+                inputs = [column for own in columns for column in own]
+                input_sets, n_inputs = len(columns), len(modulation.inputs)
                 network = [
                     *modulation.mean,
                     *modulation.scale,
@@ -690,7 +765,8 @@ def family_trigger_class(trigger_class: type[RuleTrigger]) -> type[RuleTrigger]:
                     *inputs,
                     len(inner.rule_indices),
                     len(inner.rule_parameters),
-                    len(inputs),
+                    input_sets,
+                    n_inputs,
                     *hidden,
                 ],
                 parameters=[
