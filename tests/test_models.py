@@ -41,7 +41,7 @@ SHIPPED_FROM_FRONTS = {
     "ClusterContainment-v0_ppo": ("ClusterContainment-v0_ppo/transmission_penalty=10", 1),
     "ClusterContainmentCentral-v0_ppo": (
         "ClusterContainmentCentral-v0_ppo/transmission_penalty=10",
-        0,
+        2,
     ),
     "OrbitAttitudeTracking-v0_ppo": ("OrbitAttitudeTracking-v0_ppo/transmission_penalty=1", 3),
     "OrbitAttitudeTracking-v0_self_triggered": (
