@@ -477,18 +477,18 @@ GreedyActor = Callable[[np.ndarray, "np.ndarray | None"], np.ndarray]
 
 def greedy_actor(model: Any) -> GreedyActor | None:
     """``model.predict(observation, deterministic=True, [action_masks])``'s actions, computed
-        without Stable-Baselines3's distribution objects, or ``None`` for a model it does not cover.
+    without Stable-Baselines3's distribution objects, or ``None`` for a model it does not cover.
 
     Covered, over ``Box`` observations: PPO and MaskablePPO policies of the actor-critic family
-        whose action distribution is categorical (``Discrete``, masked or not) or Bernoulli
-        (``MultiBinary``), and DQN. The same modules run in the same order on the same tensors
-        (features, actor latent, logits; Q-values for DQN), and the mode is taken as the
-        distribution takes it (torch's ``logits_to_probs`` of the normalised logits, masked ones
-        set to sb3-contrib's -1e8, then the argmax; ``round(sigmoid)`` for Bernoulli), so the
-        actions are SB3's bit for bit (``tests/test_greedy_actor.py``). Building and validating the
-        distribution object, and finding the device at every call, were two thirds of a batched
-        ``predict``'s time. Recurrent policies, and any other class whose ``get_distribution`` is
-        not the one read here, are not covered.
+    whose action distribution is categorical (``Discrete``, masked or not) or Bernoulli
+    (``MultiBinary``), and DQN. The same modules run in the same order on the same tensors
+    (features, actor latent, logits; Q-values for DQN), and the mode is taken as the
+    distribution takes it (torch's ``logits_to_probs`` of the normalised logits, masked ones
+    set to sb3-contrib's -1e8, then the argmax; ``round(sigmoid)`` for Bernoulli), so the
+    actions are SB3's bit for bit (``tests/test_greedy_actor.py``). Building and validating the
+    distribution object, and finding the device at every call, were two thirds of a batched
+    ``predict``'s time. Recurrent policies, and any other class whose ``get_distribution`` is
+    not the one read here, are not covered.
     """
     import torch
     from stable_baselines3.common.distributions import (
