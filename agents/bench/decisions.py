@@ -23,6 +23,7 @@ import gymnasium as gym
 import numpy as np
 
 import etsc_envs
+from agents.bench import require_counts
 from etsc_envs.decisions import DecisionSet, Hold, SelfTriggeredWrapper, TriggerAction
 from etsc_envs.triggers.family import FamilyPoint
 
@@ -116,8 +117,7 @@ def main(argv: list[str] | None = None) -> int:
         "--per-instant", action="store_true", help="one env.step per instant (no compiled holds)"
     )
     args = parser.parse_args(argv)
-    if args.repeats < 1:
-        parser.error(f"--repeats must be an integer >= 1, got {args.repeats}")
+    require_counts(parser, args, "repeats")
     unknown = [env_id for env_id in args.env if env_id not in etsc_envs.ENV_IDS]
     if unknown:
         parser.error(

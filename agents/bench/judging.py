@@ -20,6 +20,7 @@ import statistics
 import time
 from typing import Any
 
+from agents.bench import require_counts
 from etsc_envs.cli import positive_integer
 from etsc_envs.decisions import SelfTriggeredPolicy
 from etsc_envs.evaluation.arguments import limit_torch_threads
@@ -59,8 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--repeats", type=int, default=3, help="timed runs of each path")
     args = parser.parse_args(argv)
-    if args.repeats < 1:
-        parser.error(f"--repeats must be an integer >= 1, got {args.repeats}")
+    require_counts(parser, args, "repeats")
     limit_torch_threads()
     try:  # the id, the set and the model are checked before anything is timed
         scenarios = scenario_set("test", args.set_size)

@@ -22,6 +22,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from agents.bench import require_counts
 from agents.search.cma_es import Evaluator, SearchConfig, load_config, run_search
 
 DEFAULT_CONFIGS = ("configs/search/attitude_tracking.yaml", "configs/search/inner_formation.yaml")
@@ -59,9 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--generations", type=int, default=1, help="generations per timed run")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs per config")
     args = parser.parse_args(argv)
-    for name in ("generations", "repeats"):
-        if getattr(args, name) < 1:
-            parser.error(f"--{name} must be an integer >= 1, got {getattr(args, name)}")
+    require_counts(parser, args, "generations", "repeats")
     try:  # every config is checked before the first is timed
         configs = [load_config(path) for path in args.config or DEFAULT_CONFIGS]
     except ValueError as error:
