@@ -82,6 +82,7 @@ from etsc_envs.triggers.family import (
     FamilyPoint,
     LearnedTrigger,
     Modulation,
+    channel_name,
     require_factors,
     require_keywords,
 )
@@ -290,9 +291,9 @@ def _inputs(env_id: str, value: Any, names: tuple[str, ...]) -> tuple[str, ...]:
                 f"on {env_id} (an input such as 's_norm{CHANNEL}')"
             )
         if CHANNEL not in name or pettingzoo:
-            expanded = [name.replace(CHANNEL, "")]
+            expanded = [channel_name(name, None)]
         else:
-            expanded = [name.replace(CHANNEL, f"_{c}") for c in range(channels)]
+            expanded = [channel_name(name, c) for c in range(channels)]
         missing = [entry for entry in expanded if entry not in names]
         if missing:
             raise ValueError(

@@ -113,6 +113,12 @@ form), or with nothing where the trigger serves one agent whose observation name
 unsuffixed (``s_norm``, an agent of the PettingZoo form), the layouts of the paper triggers."""
 
 
+def channel_name(name: str, channel: int | None) -> str:
+    """The observation name input ``name`` reads on channel ``channel`` (``None``: the one
+    channel of an agent's unsuffixed observation; see :data:`CHANNEL`)."""
+    return name.replace(CHANNEL, "" if channel is None else f"_{channel}")
+
+
 @dataclass(frozen=True)
 class Modulation:
     """The state-dependent part of θ: ``g = clip(W3 tanh(W2 tanh(W1 x + b1) + b2) + b3)``
@@ -139,7 +145,8 @@ class Modulation:
 
     def __post_init__(self) -> None:
         for name in self.inputs:
-            if "{" in name.replace(CHANNEL, "") or "}" in name.replace(CHANNEL, ""):
+            rest = channel_name(name, None)
+            if "{" in rest or "}" in rest:
                 raise ValueError(
                     f"modulation.inputs: {name!r} holds braces other than {CHANNEL}, the only "
                     "placeholder of an input name"
@@ -205,8 +212,7 @@ class Modulation:
     def channel_inputs(self, channel: int | None) -> tuple[str, ...]:
         """The observation names channel ``channel`` reads (``None``: the one channel of an
         agent's unsuffixed observation; see :data:`CHANNEL`)."""
-        suffix = "" if channel is None else f"_{channel}"
-        return tuple(name.replace(CHANNEL, suffix) for name in self.inputs)
+        return tuple(channel_name(name, channel) for name in self.inputs)
 
     def input_columns(self, names: tuple[str, ...], channels: int) -> list[list[int]]:
         """The columns of an observation with these names that the network reads: one set
