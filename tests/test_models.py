@@ -15,7 +15,8 @@ from etsc_envs.sb3_models import NormalizedModel, load_sb3, normalization_path
 
 ROOT = Path(__file__).parents[1]
 MODELS = sorted((ROOT / "models").glob("*-v0_*.zip"))
-"""``models/<id>_<method>.zip``: per-instant PPO (``_ppo``) and self-triggered decisions."""
+"""``models/<id>_<method>.zip``: per-instant PPO (``_ppo``), self-triggered PPO
+(``_self_triggered``) and self-triggered DQN (``_self_triggered_dqn``)."""
 RESULTS = ROOT / "docs" / "results"
 CROSS_MACHINE_SPREAD = {"etsc/OrbitAttitudeTracking-v0": 5e-3}
 """Relative spread of a recorded paper-scenario row between machines, by id: 000's closed loop
@@ -31,6 +32,10 @@ SHIPPED_FROM_FRONTS = {
     "AttitudeTracking-v0_ppo": ("AttitudeTracking-v0_ppo/transmission_penalty=300", 0),
     "AttitudeTracking-v0_self_triggered": (
         "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
+        0,
+    ),
+    "AttitudeTracking-v0_self_triggered_dqn": (
+        "AttitudeTracking-v0_self_triggered_dqn/transmission_penalty=300",
         0,
     ),
     "AsteroidOrbitKeeping-v0_ppo": ("AsteroidOrbitKeeping-v0_ppo/transmission_penalty=1", 3),
