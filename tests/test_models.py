@@ -53,6 +53,10 @@ SHIPPED_FROM_FRONTS = {
         "OrbitAttitudeTracking-v0_self_triggered_scratch/transmission_penalty=1",
         2,
     ),
+    "OrbitAttitudeTracking-v0_self_triggered_dqn": (
+        "OrbitAttitudeTracking-v0_self_triggered_dqn/transmission_penalty=1",
+        4,
+    ),
     "InnerFormation-v0_ppo": ("InnerFormation-v0_ppo/transmission_penalty=5", 1),
     "InnerFormation-v0_self_triggered": (
         "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
