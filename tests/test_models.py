@@ -48,6 +48,14 @@ SHIPPED_FROM_FRONTS = {
         "ClusterContainmentCentral-v0_ppo/transmission_penalty=10",
         2,
     ),
+    "ClusterContainment-v0_self_triggered_dqn": (
+        "ClusterContainment-v0_self_triggered_dqn/transmission_penalty=10",
+        0,
+    ),
+    "ClusterContainmentCentral-v0_self_triggered_dqn": (
+        "ClusterContainmentCentral-v0_self_triggered_dqn/transmission_penalty=1",
+        4,
+    ),
     "OrbitAttitudeTracking-v0_ppo": ("OrbitAttitudeTracking-v0_ppo/transmission_penalty=1", 3),
     "OrbitAttitudeTracking-v0_self_triggered": (
         "OrbitAttitudeTracking-v0_self_triggered_scratch/transmission_penalty=1",
