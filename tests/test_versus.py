@@ -143,3 +143,12 @@ def test_a_model_of_neither_path_nor_bytes_is_refused(records, tmp_path: Path) -
     _, theirs = versus.load_record(reference, "REFERENCE")
     with pytest.raises(ValueError, match="none of the reference's models"):
         versus.reference_index(theirs, str(other))
+
+
+def test_a_json_model_is_known_by_its_data_whatever_its_layout(records, tmp_path: Path) -> None:
+    """A shipped trigger is written indented and a record's copy compact: the same model."""
+    _, reference, _ = records
+    indented = tmp_path / "indented.json"
+    indented.write_text(json.dumps({"point": 2}, indent=2))
+    _, theirs = versus.load_record(reference, "REFERENCE")
+    assert versus.reference_index(theirs, str(indented)) == 1

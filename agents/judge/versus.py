@@ -20,13 +20,15 @@ transmissions or less cost at the 95 % bound, and no more of the other. ::
     python -m agents.judge.versus CANDIDATE REFERENCE --reference-model PATH [--json PATH]
 
 CANDIDATE and REFERENCE are ``results.json`` files or the folders holding them. PATH names the
-reference's model as its record lists it, or any file with the same bytes (a shipped copy such
-as ``models/<id>_learned.json``); it may be left out where the reference judged one model.
+reference's model as its record lists it, or any file with the same contents (a shipped copy such
+as ``models/<id>_learned.json``: JSON files are compared as data, so a record's compact copy of
+an indented file is the same model); it may be left out where the reference judged one model.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 from pathlib import Path
 from typing import Any
 
@@ -63,8 +65,8 @@ def load_record(path: str | Path, argument: str) -> tuple[Path, dict[str, Any]]:
 
 def reference_index(record: dict[str, Any], model: str | None) -> int:
     """Which of ``record``'s models ``model`` names: its path as listed, or a file with the
-    same bytes as one listed; ``None`` for the only one. ``ValueError`` naming
-    ``--reference-model`` otherwise."""
+    same contents as one listed (:func:`_contents`); ``None`` for the only one.
+    ``ValueError`` naming ``--reference-model`` otherwise."""
     models = list(record["models"])
     if model is None:
         if len(models) != 1:
@@ -75,11 +77,10 @@ def reference_index(record: dict[str, Any], model: str | None) -> int:
         return 0
     if model in models:
         return models.index(model)
-    try:
-        data = Path(model).read_bytes()
-    except OSError:
-        raise ValueError(f"--reference-model: cannot read {model!r}") from None
-    same = [i for i, listed in enumerate(models) if _bytes(listed) == data]
+    data = _contents(model)
+    if data is None:
+        raise ValueError(f"--reference-model: cannot read {model!r}")
+    same = [i for i, listed in enumerate(models) if _contents(listed) == data]
     if not same:
         raise ValueError(
             f"--reference-model: {model!r} is none of the reference's models "
@@ -88,12 +89,18 @@ def reference_index(record: dict[str, Any], model: str | None) -> int:
     return same[0]
 
 
-def _bytes(path: str) -> bytes | None:
-    """The contents of ``path`` (``None`` where it cannot be read)."""
+def _contents(path: str) -> object:
+    """The contents of ``path``: its data where it is JSON (a learned trigger file, written
+    indented in ``models/`` and compact in records), else its bytes (an SB3 zip); ``None``
+    where it cannot be read."""
     try:
-        return Path(path).read_bytes()
+        data = Path(path).read_bytes()
     except OSError:
         return None
+    try:
+        return json.loads(data)
+    except ValueError:
+        return data
 
 
 def compare_records(
