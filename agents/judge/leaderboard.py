@@ -179,6 +179,20 @@ def cluster_ppo(env_id: str, form: str, values: str) -> LearnerRecord:
     )
 
 
+def self_triggered_dqn(
+    env_id: str, sweep_name: str, penalty: str, what: str, processes: int = 2
+) -> LearnerRecord:
+    """An id's self-triggered DQN row: the five seeds of ``configs/sweeps/<sweep_name>.yaml`` at
+    the judged ``penalty``, in ``<id>_self_triggered_dqn/``; ``what`` follows "DQN
+    (semi-Markov target) on the same decisions, "."""
+    record = f"{env_id.removeprefix('etsc/')}_self_triggered_dqn"
+    return LearnerRecord(
+        f"{record}/transmission_penalty={penalty}",
+        f"DQN (semi-Markov target) on the same decisions, {what}",
+        learner_front(env_id, sweep_name, record, processes=processes),
+    )
+
+
 BOARDS = (
     Board(
         "etsc/OrbitAttitudeTracking-v0",
@@ -209,17 +223,14 @@ BOARDS = (
                     "OrbitAttitudeTracking-v0_self_triggered_scratch",
                 ),
             ),
-            "self-triggered DQN": LearnerRecord(
-                "OrbitAttitudeTracking-v0_self_triggered_dqn/transmission_penalty=1",
-                "DQN (semi-Markov target) on the same decisions, from scratch, 5 seeds at "
+            "self-triggered DQN": self_triggered_dqn(
+                "etsc/OrbitAttitudeTracking-v0",
+                "orbit_attitude_self_triggered_dqn",
+                "1",
+                "from scratch, 5 seeds at "
                 "λ = 1 (100 000 decisions of 60-s episodes each), best-validation checkpoints "
                 "(λ = 1 does not contain the paper rule on validation: ×1.09 its transmissions "
                 "at ×1.001 its cost)",
-                learner_front(
-                    "etsc/OrbitAttitudeTracking-v0",
-                    "orbit_attitude_self_triggered_dqn",
-                    "OrbitAttitudeTracking-v0_self_triggered_dqn",
-                ),
             ),
         },
     ),
@@ -246,17 +257,14 @@ BOARDS = (
                     "ClusterContainment-v0_self_triggered_scratch",
                 ),
             ),
-            "self-triggered DQN": LearnerRecord(
-                "ClusterContainment-v0_self_triggered_dqn/transmission_penalty=10",
-                "DQN (semi-Markov target) on the same decisions, one Q-network shared by the "
+            "self-triggered DQN": self_triggered_dqn(
+                "etsc/ClusterContainment-v0",
+                "cluster_shared_self_triggered_dqn",
+                "10",
+                "one Q-network shared by the "
                 "followers, from scratch, 5 seeds at λ = 10 per follower update (12 288 "
                 "follower decisions of 1200-s episodes each), best-validation checkpoints "
                 "(λ = 10 does not contain the paper rule on validation: ×113 its updates)",
-                learner_front(
-                    "etsc/ClusterContainment-v0",
-                    "cluster_shared_self_triggered_dqn",
-                    "ClusterContainment-v0_self_triggered_dqn",
-                ),
             ),
         },
     ),
@@ -284,17 +292,14 @@ BOARDS = (
                     judged_sweep="cluster_central_self_triggered",
                 ),
             ),
-            "self-triggered DQN": LearnerRecord(
-                "ClusterContainmentCentral-v0_self_triggered_dqn/transmission_penalty=1",
-                "DQN (semi-Markov target) on the same decisions, from scratch, 5 seeds at λ = 1 "
+            "self-triggered DQN": self_triggered_dqn(
+                "etsc/ClusterContainmentCentral-v0",
+                "cluster_central_self_triggered_dqn",
+                "1",
+                "from scratch, 5 seeds at λ = 1 "
                 "per follower update (20 000 decisions of 1200-s episodes each), "
                 "best-validation checkpoints (no λ of 1, 10 contained the paper rule on "
                 "validation; 1 came closest: ×74 its updates at ×0.998 its cost)",
-                learner_front(
-                    "etsc/ClusterContainmentCentral-v0",
-                    "cluster_central_self_triggered_dqn",
-                    "ClusterContainmentCentral-v0_self_triggered_dqn",
-                ),
             ),
         },
     ),
@@ -325,16 +330,13 @@ BOARDS = (
                     "AttitudeTracking-v0_self_triggered_scratch",
                 ),
             ),
-            "self-triggered DQN": LearnerRecord(
-                "AttitudeTracking-v0_self_triggered_dqn/transmission_penalty=300",
-                "DQN (semi-Markov target) on the same decisions, from scratch, 5 seeds at "
+            "self-triggered DQN": self_triggered_dqn(
+                "etsc/AttitudeTracking-v0",
+                "attitude_tracking_self_triggered_dqn",
+                "300",
+                "from scratch, 5 seeds at "
                 "λ = 300, best-validation checkpoints (no λ of 100, 300 contained the paper rule "
                 "on validation; 300 came closest: ×1.95 its transmissions at ×1.13 its cost)",
-                learner_front(
-                    "etsc/AttitudeTracking-v0",
-                    "attitude_tracking_self_triggered_dqn",
-                    "AttitudeTracking-v0_self_triggered_dqn",
-                ),
             ),
         },
     ),
@@ -364,18 +366,15 @@ BOARDS = (
                     "AsteroidOrbitKeeping-v0_self_triggered_scratch",
                 ),
             ),
-            "self-triggered DQN": LearnerRecord(
-                "AsteroidOrbitKeeping-v0_self_triggered_dqn/transmission_penalty=0.3",
-                "DQN (semi-Markov target) on the same decisions, unmasked (the shield replaces "
+            "self-triggered DQN": self_triggered_dqn(
+                "etsc/AsteroidOrbitKeeping-v0",
+                "asteroid_self_triggered_dqn",
+                "0.3",
+                "unmasked (the shield replaces "
                 "an unsafe hold), 5 seeds at the PPO front's λ = 0.3, best-validation "
                 "checkpoints (λ does not contain the paper rule on validation: every seed "
                 "leaves the region or collides on most scenarios)",
-                learner_front(
-                    "etsc/AsteroidOrbitKeeping-v0",
-                    "asteroid_self_triggered_dqn",
-                    "AsteroidOrbitKeeping-v0_self_triggered_dqn",
-                    processes=1,
-                ),
+                processes=1,
             ),
         },
     ),
