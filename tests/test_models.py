@@ -43,6 +43,10 @@ SHIPPED_FROM_FRONTS = {
         "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
         0,
     ),
+    "AsteroidOrbitKeeping-v0_self_triggered_dqn": (
+        "AsteroidOrbitKeeping-v0_self_triggered_dqn/transmission_penalty=0.3",
+        2,
+    ),
     "ClusterContainment-v0_ppo": ("ClusterContainment-v0_ppo/transmission_penalty=10", 1),
     "ClusterContainmentCentral-v0_ppo": (
         "ClusterContainmentCentral-v0_ppo/transmission_penalty=10",
