@@ -183,6 +183,26 @@ def test_an_out_folder_holding_other_runs_is_refused(tmp_path: Path, capsys) -> 
     assert result["methods"]["ppo"]["reached"] == "1/2"
 
 
+@pytest.mark.parametrize(
+    ("content", "says"),
+    [
+        (None, "cannot be read as JSON"),
+        ("{", "cannot be read as JSON"),
+        ("[1]", "not a learning_curves.json"),
+    ],
+)
+def test_an_unreadable_include_is_refused_in_one_line(
+    tmp_path: Path, capsys, content: str | None, says: str
+) -> None:
+    earlier = tmp_path / "learning_curves.json"
+    if content is not None:
+        earlier.write_text(content, encoding="utf-8")
+    with pytest.raises(SystemExit):
+        main(["--include", str(earlier), "--out", str(tmp_path / "out")])
+    (line,) = [text for text in capsys.readouterr().err.splitlines() if "error:" in text]
+    assert f"--include {earlier}: {says}" in line
+
+
 def test_searches_of_one_configuration_share_one_paper_evaluation(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

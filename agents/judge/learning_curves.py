@@ -238,6 +238,21 @@ def seed_bands(runs: list[dict[str, Any]]) -> dict[str, Any] | None:
     return bands
 
 
+def read_earlier(path: Path) -> dict[str, Any]:
+    """The ``learning_curves.json`` given to ``--include``, refused in one line naming the
+    option when it cannot be read or is not such a result."""
+    try:
+        result = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise ValueError(f"--include {path}: cannot be read as JSON ({error})") from None
+    if not isinstance(result, dict) or not isinstance(result.get("methods"), dict):
+        raise ValueError(
+            f"--include {path}: not a learning_curves.json (no 'methods' object); give the "
+            "file python -m agents.judge.learning_curves wrote"
+        )
+    return result
+
+
 def learning_curves(
     runs: list[tuple[str, Path]],
     cost_tolerance: float,
@@ -398,7 +413,7 @@ def main(argv: list[str] | None = None) -> int:
     out_dir = args.out or Path("results") / "learning_curves"
     try:
         require_writable_folder(out_dir, "--out")
-        earlier = [json.loads(path.read_text(encoding="utf-8")) for path in args.include]
+        earlier = [read_earlier(path) for path in args.include]
         runs = parse_runs(args.run) if args.run or not earlier else []
         require_own_curves(out_dir, runs, earlier)
         result = learning_curves(runs, args.cost_tolerance, earlier)
