@@ -372,6 +372,7 @@ def test_the_command_refuses_bad_input_in_one_line(tmp_path, capsys) -> None:
         (["--budget-episodes", "0"], "error: --budget-episodes must be a number > 0, got 0.0"),
         (["--tuning-episodes", "-2"], "error: --tuning-episodes must be a number >= 0, got -2.0"),
         (["--scenarios", "paper"], "error: --scenarios must be one of"),
+        (["--trigger", str(tmp_path / "none.json")], "error: --trigger: "),
     ]:
         assert oracle_main([*base, *change]) == 2
         assert capsys.readouterr().err.strip().startswith(line)

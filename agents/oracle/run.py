@@ -94,7 +94,10 @@ def oracle_config_from_dict(raw: Any) -> OracleConfig:
     tail = values["tail"]
     if tail is not None and (isinstance(tail, bool) or not isinstance(tail, int) or tail < 0):
         raise ValueError(f"key 'tail' must be an integer >= 0 or null, got {tail!r}")
-    learned = LearnedTrigger.load(values["trigger"])
+    try:
+        learned = LearnedTrigger.load(values["trigger"])
+    except ValueError as error:
+        raise ValueError(f"key 'trigger': {error}") from None
     if learned.env_id != values["env_id"]:
         raise ValueError(
             f"key 'trigger': {values['trigger']!r} is a trigger of {learned.env_id!r}, "
