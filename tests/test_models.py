@@ -74,6 +74,10 @@ SHIPPED_FROM_FRONTS = {
         "InnerFormation-v0_self_triggered_scratch/transmission_penalty=5",
         4,
     ),
+    "InnerFormation-v0_self_triggered_dqn": (
+        "InnerFormation-v0_self_triggered_dqn/transmission_penalty=5",
+        1,
+    ),
 }
 """Each model shipped from a protocol front (``agents.results --sweep``): the record of the
 chosen penalty's seeds, and which seed the model is (the best on validation); every other

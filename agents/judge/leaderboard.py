@@ -406,6 +406,14 @@ BOARDS = (
                     "InnerFormation-v0_self_triggered_scratch",
                 ),
             ),
+            "self-triggered DQN": self_triggered_dqn(
+                "etsc/InnerFormation-v0",
+                "inner_formation_self_triggered_dqn",
+                "5",
+                "unmasked (the shield replaces an unsafe hold), from scratch, 5 seeds at λ = 5 "
+                "(200 000 decisions of 20-s episodes each), best-validation checkpoints (λ = 5 "
+                "does not contain the paper rule on validation: ×17 its transmissions)",
+            ),
         },
     ),
 )
