@@ -31,7 +31,7 @@ last digit."""
 SHIPPED_FROM_FRONTS = {
     "AttitudeTracking-v0_ppo": ("AttitudeTracking-v0_ppo/transmission_penalty=300", 0),
     "AttitudeTracking-v0_self_triggered": (
-        "AttitudeTracking-v0_self_triggered_scratch/transmission_penalty=300",
+        "AttitudeTracking-v0_self_triggered_tuned/transmission_penalty=300",
         0,
     ),
     "AttitudeTracking-v0_self_triggered_dqn": (

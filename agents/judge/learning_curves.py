@@ -286,6 +286,8 @@ def plot(result: dict[str, Any], path: Path) -> None:
     """Cost and transmissions relative to the paper trigger, against instants and seconds."""
     figure, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharey="row")
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    if len(result["methods"]) > len(colours):  # a colour per method, none repeated
+        colours = [plt.get_cmap("tab20")(i) for i in range(20)]
     legend = []  # one entry per method, drawn whether or not its band exists on every panel
     for index, (label, method) in enumerate(result["methods"].items()):
         colour = colours[index % len(colours)]
