@@ -40,7 +40,7 @@ SHIPPED_FROM_FRONTS = {
     ),
     "AsteroidOrbitKeeping-v0_ppo": ("AsteroidOrbitKeeping-v0_ppo/transmission_penalty=1", 3),
     "AsteroidOrbitKeeping-v0_self_triggered": (
-        "AsteroidOrbitKeeping-v0_self_triggered_scratch/transmission_penalty=0.3",
+        "AsteroidOrbitKeeping-v0_self_triggered_tuned/transmission_penalty=0.3",
         0,
     ),
     "AsteroidOrbitKeeping-v0_self_triggered_dqn": (
