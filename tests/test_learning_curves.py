@@ -186,8 +186,8 @@ def test_an_out_folder_holding_other_runs_is_refused(tmp_path: Path, capsys) -> 
 @pytest.mark.parametrize(
     ("content", "says"),
     [
-        (None, "cannot be read as JSON"),
-        ("{", "cannot be read as JSON"),
+        (None, "not a readable JSON file"),
+        ("{", "not JSON"),
         ("[1]", "not a learning_curves.json"),
     ],
 )

@@ -241,10 +241,7 @@ def seed_bands(runs: list[dict[str, Any]]) -> dict[str, Any] | None:
 def read_earlier(path: Path) -> dict[str, Any]:
     """The ``learning_curves.json`` given to ``--include``, refused in one line naming the
     option when it cannot be read or is not such a result."""
-    try:
-        result = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as error:
-        raise ValueError(f"--include {path}: cannot be read as JSON ({error})") from None
+    result = read_json_file(path, f"--include {path}")
     if not isinstance(result, dict) or not isinstance(result.get("methods"), dict):
         raise ValueError(
             f"--include {path}: not a learning_curves.json (no 'methods' object); give the "
