@@ -28,14 +28,13 @@ an indented file is the same model); it may be left out where the reference judg
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from etsc_envs.core.files import output_file_argument
-from etsc_envs.core.json_files import read_json_file
+from etsc_envs.core.json_files import read_json_file, read_json_text
 from etsc_envs.evaluation.arguments import write_json
 from etsc_envs.evaluation.statistics import seeds_ratio
 from etsc_envs.evaluation.verdict import compare, ratio_axis
@@ -98,8 +97,8 @@ def _contents(path: str) -> object:
     except OSError:
         return None
     try:
-        return json.loads(data)
-    except ValueError:
+        return read_json_text(data.decode("utf-8"))
+    except ValueError:  # UnicodeDecodeError included: a zip's bytes
         return data
 
 
