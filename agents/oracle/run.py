@@ -36,7 +36,7 @@ from agents.oracle.schedule import ScheduleRun
 from agents.oracle.search import clairvoyant
 from agents.sweep.results import ORACLE_FILE
 from etsc_envs.core.files import atomic_write_text
-from etsc_envs.core.json_files import require_mapping
+from etsc_envs.core.json_files import in_file, require_mapping
 from etsc_envs.protocol import (
     DEFAULT_SET_SIZE,
     RESERVED_SEEDS,
@@ -94,10 +94,8 @@ def oracle_config_from_dict(raw: Any) -> OracleConfig:
     tail = values["tail"]
     if tail is not None and (isinstance(tail, bool) or not isinstance(tail, int) or tail < 0):
         raise ValueError(f"key 'tail' must be an integer >= 0 or null, got {tail!r}")
-    try:
+    with in_file("key 'trigger'"):
         learned = LearnedTrigger.load(values["trigger"])
-    except ValueError as error:
-        raise ValueError(f"key 'trigger': {error}") from None
     if learned.env_id != values["env_id"]:
         raise ValueError(
             f"key 'trigger': {values['trigger']!r} is a trigger of {learned.env_id!r}, "
