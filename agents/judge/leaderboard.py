@@ -193,6 +193,29 @@ def self_triggered_dqn(
     )
 
 
+def self_triggered_tuned(
+    env_id: str, problem: str, penalty: str, decisions: str, choice: str
+) -> LearnerRecord:
+    """An id's self-triggered PPO row at hyperparameters tuned on validation: the front
+    ``configs/sweeps/<problem>_self_triggered_front.yaml`` chose ``penalty``, and the five seeds
+    of ``<problem>_self_triggered.yaml`` at the tuned values are judged into
+    ``<id>_self_triggered_tuned/``; ``decisions`` says what the policy chooses from, ``choice``
+    (after "5 seeds at λ = <penalty>") how the penalty and checkpoints were chosen."""
+    record = f"{env_id.removeprefix('etsc/')}_self_triggered_tuned"
+    return LearnerRecord(
+        f"{record}/transmission_penalty={penalty}",
+        f"{decisions}, hyperparameters tuned on validation (6 Optuna trials × 2 seeds at "
+        f"λ = {penalty}; the best trial's two runs are seeds 0 and 1), 5 seeds at "
+        f"λ = {penalty}{choice}",
+        learner_front(
+            env_id,
+            f"{problem}_self_triggered_front",
+            record,
+            judged_sweep=f"{problem}_self_triggered",
+        ),
+    )
+
+
 BOARDS = (
     Board(
         "etsc/OrbitAttitudeTracking-v0",
@@ -319,19 +342,13 @@ BOARDS = (
                     "AttitudeTracking-v0_ppo",
                 ),
             ),
-            "self-triggered PPO": LearnerRecord(
-                "AttitudeTracking-v0_self_triggered_tuned/transmission_penalty=300",
-                "holds or eq. (27) × f from scratch, hyperparameters tuned on validation (6 "
-                "Optuna trials × 2 seeds at λ = 300; the best trial's two runs are seeds 0 and "
-                "1), 5 seeds at λ = 300, best-validation checkpoints (no λ of 100, 300 "
-                "contained the paper rule on validation at the values before tuning; 300 came "
-                "closest)",
-                learner_front(
-                    "etsc/AttitudeTracking-v0",
-                    "attitude_tracking_self_triggered_front",
-                    "AttitudeTracking-v0_self_triggered_tuned",
-                    judged_sweep="attitude_tracking_self_triggered",
-                ),
+            "self-triggered PPO": self_triggered_tuned(
+                "etsc/AttitudeTracking-v0",
+                "attitude_tracking",
+                "300",
+                "holds or eq. (27) × f from scratch",
+                ", best-validation checkpoints (no λ of 100, 300 contained the paper rule on "
+                "validation at the values before tuning; 300 came closest)",
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/AttitudeTracking-v0",
@@ -359,18 +376,13 @@ BOARDS = (
                     "AsteroidOrbitKeeping-v0_ppo",
                 ),
             ),
-            "self-triggered PPO": LearnerRecord(
-                "AsteroidOrbitKeeping-v0_self_triggered_tuned/transmission_penalty=0.3",
-                "MaskablePPO: holds or eq. (15) × f from scratch, hyperparameters tuned on "
-                "validation (6 Optuna trials × 2 seeds at λ = 0.3; the best trial's two runs are "
-                "seeds 0 and 1), 5 seeds at λ = 0.3 (chosen on validation from 0.3, 1, 3, 10 at "
-                "the values before tuning), best-validation checkpoints",
-                learner_front(
-                    "etsc/AsteroidOrbitKeeping-v0",
-                    "asteroid_self_triggered_front",
-                    "AsteroidOrbitKeeping-v0_self_triggered_tuned",
-                    judged_sweep="asteroid_self_triggered",
-                ),
+            "self-triggered PPO": self_triggered_tuned(
+                "etsc/AsteroidOrbitKeeping-v0",
+                "asteroid",
+                "0.3",
+                "MaskablePPO: holds or eq. (15) × f from scratch",
+                " (chosen on validation from 0.3, 1, 3, 10 at the values before tuning), "
+                "best-validation checkpoints",
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/AsteroidOrbitKeeping-v0",
