@@ -261,3 +261,50 @@ def test_training_counts_the_sampling_instants_each_step_simulates(tmp_path: Pat
     callback.locals = {"infos": [{}, {}, {"elapsed_steps": 3}]}
     callback._on_step()
     assert callback.env_steps == 4 + 4 + 3
+
+
+_SEARCH_CONFIG = (
+    "env_id: etsc/InnerFormation-v0\npenalty: 5.0\nsearch: [factors]\ngenerations: 2\n"
+    "population: 2\nscenarios: 1\nvalidation_size: 2\n"
+)
+
+
+@pytest.mark.parametrize(
+    ("files", "says"),
+    [
+        ({"evaluations.json": '[{"timesteps": 1'}, "evaluations.json: not JSON"),
+        ({"evaluations.json": '{"a": 1}'}, "evaluations.json: not a record of agents.train"),
+        ({"evaluations.json": '[{"timesteps": 1, "env_steps": 2}]'}, "KeyError('learned')"),
+        ({"evaluations.json": "[]"}, "no validation recorded yet"),
+        ({"curve.json": "[1]", "config.yaml": _SEARCH_CONFIG}, "curve.json: not a record"),
+        ({"generations.jsonl": '{"env_steps": 1, "validation": {}}\n'}, "KeyError('wall_s')"),
+        ({"generations.jsonl": "{\n{}\n"}, "generations.jsonl: line 1: not JSON"),
+        ({"curve.json": "{}", "config.yaml": "x: ["}, "config.yaml: not a readable YAML file"),
+        ({"curve.json": "{}", "config.yaml": "x: 1"}, "config.yaml: config key 'search'"),
+    ],
+)
+def test_a_damaged_run_record_is_refused_in_one_line_naming_the_run(
+    tmp_path: Path, capsys, files: dict[str, str], says: str
+) -> None:
+    """Whatever is wrong inside a run's folder, the error is one line that starts with the
+    --run it came from and names the file."""
+    folder = tmp_path / "run"
+    folder.mkdir()
+    for name, text in files.items():
+        (folder / name).write_text(text, encoding="utf-8")
+    if "generations.jsonl" in files:
+        (folder / "config.yaml").write_text(_SEARCH_CONFIG, encoding="utf-8")
+    with pytest.raises(SystemExit):
+        main(["--run", f"es={folder}", "--out", str(tmp_path / "out")])
+    (line,) = [text for text in capsys.readouterr().err.splitlines() if "error:" in text]
+    assert f"--run es={folder}: " in line and says in line
+
+
+def test_a_search_being_written_is_read_up_to_its_last_whole_generation(tmp_path: Path) -> None:
+    """A torn last line of generations.jsonl (the search is writing it) is left out."""
+    folder = tmp_path / "search"
+    folder.mkdir()
+    validation = {"mean_cost": 1.0, "transmissions": 10.0, "failures": 0}
+    whole = {"generation": 0, "env_steps": 100, "wall_s": 1.0, "validation": validation}
+    (folder / "generations.jsonl").write_text(json.dumps(whole) + '\n{"generation": 1, "env')
+    assert search_validations(folder) == [{"env_steps": 100, "wall_s": 1.0, **validation}]

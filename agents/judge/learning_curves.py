@@ -41,6 +41,8 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -50,7 +52,7 @@ from matplotlib.lines import Line2D
 
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
-from etsc_envs.core.json_files import read_json_file, require_mapping
+from etsc_envs.core.json_files import in_file, read_json_file, read_json_lines, require_mapping
 from etsc_envs.evaluation.arguments import write_json
 from etsc_envs.evaluation.statistics import summarize
 
@@ -89,28 +91,43 @@ def parse_runs(specs: list[str]) -> list[tuple[str, Path]]:
 
 def search_validations(folder: Path) -> list[dict[str, Any]]:
     """The validated mean of each validating generation of the search in ``folder``: from
-    ``generations.jsonl``, else from ``curve.json`` (``failures`` ``None`` where the curve
-    does not keep them); each with its ``env_steps`` and ``wall_s``."""
-    if (folder / "generations.jsonl").is_file():
-        lines = (folder / "generations.jsonl").read_text(encoding="utf-8").splitlines()
-        records = [json.loads(line) for line in lines]
+    ``generations.jsonl`` (a torn last line, a generation being written, is left out), else
+    from ``curve.json`` (``failures`` ``None`` where the curve does not keep them); each with
+    its ``env_steps`` and ``wall_s``."""
+    generations = folder / "generations.jsonl"
+    if generations.is_file():
+        records, _ = read_json_lines(generations, generations.name)
+        with _record_keys(generations.name):
+            return [
+                {"env_steps": r["env_steps"], "wall_s": r["wall_s"], **r["validation"]}
+                for r in records
+                if "validation" in r
+            ]
+    curve_file = folder / "curve.json"
+    with _record_keys(curve_file.name):
         return [
-            {"env_steps": r["env_steps"], "wall_s": r["wall_s"], **r["validation"]}
-            for r in records
-            if "validation" in r
+            {
+                "env_steps": entry["env_steps"],
+                "wall_s": entry["wall_s"],
+                "mean_cost": entry["validation_cost"],
+                "transmissions": entry["validation_transmissions"],
+                "failures": entry.get("validation_failures"),
+            }
+            for entry in read_json_file(curve_file, curve_file.name)["curve"]
+            if "validation_cost" in entry
         ]
-    curve = json.loads((folder / "curve.json").read_text(encoding="utf-8"))["curve"]
-    return [
-        {
-            "env_steps": entry["env_steps"],
-            "wall_s": entry["wall_s"],
-            "mean_cost": entry["validation_cost"],
-            "transmissions": entry["validation_transmissions"],
-            "failures": entry.get("validation_failures"),
-        }
-        for entry in curve
-        if "validation_cost" in entry
-    ]
+
+
+@contextmanager
+def _record_keys(name: str) -> Iterator[None]:
+    """A record of the wrong shape (a key missing, a list for a mapping) as one ``ValueError``
+    naming the file ``name``."""
+    try:
+        yield
+    except (KeyError, TypeError, AttributeError) as error:
+        raise ValueError(
+            f"{name}: not a record of agents.train or agents.search ({error!r})"
+        ) from None
 
 
 @functools.cache
@@ -134,9 +151,12 @@ def search_evaluations(folder: Path) -> list[dict[str, Any]]:
     """A search's validation curve (:func:`search_validations`) in the form of a training
     run's ``evaluations.json``, the paper trigger evaluated once on the same validation
     scenarios (those of the search's ``config.yaml``) as the reference."""
-    from agents.search.cma_es import load_config
+    from agents.search.cma_es import config_from_dict, read_config
 
-    config = load_config(folder / "config.yaml")
+    path = folder / "config.yaml"
+    raw = read_config(path, where=path.name)
+    with in_file(path.name):
+        config = config_from_dict(raw)
     paper = paper_validation(
         config.env_id,
         json.dumps(config.env_args(training=False), sort_keys=True),
@@ -156,30 +176,34 @@ def search_evaluations(folder: Path) -> list[dict[str, Any]]:
 
 def run_curve(folder: Path, cost_tolerance: float) -> dict[str, Any]:
     """One run's validation curve relative to the paper trigger, and where it reached it."""
-    if not (folder / "evaluations.json").is_file():
-        evaluations = search_evaluations(folder)
+    record = folder / "evaluations.json"
+    if record.is_file():
+        evaluations = read_json_file(record, record.name)
     else:
-        evaluations = json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
-    missing = [entry["timesteps"] for entry in evaluations if "env_steps" not in entry]
-    if missing:
-        raise ValueError(
-            f"{folder}: evaluations at {missing} record no env_steps (trained before they "
-            f"were logged); retrain to compare learning speed"
-        )
-    points = []
-    for entry in evaluations:
-        learned, paper = entry["learned"], entry["paper"]
-        points.append(
-            {
-                "timesteps": entry["timesteps"],
-                "env_steps": entry["env_steps"],
-                "wall_time_s": entry["wall_time_s"],
-                "cost_ratio": learned["mean_cost"] / paper["mean_cost"],
-                "transmission_ratio": learned["transmissions"] / paper["transmissions"],
-                "failures": learned["failures"],
-            }
-        )
-    paper_failures = evaluations[0]["paper"]["failures"]
+        evaluations = search_evaluations(folder)
+    with _record_keys(record.name):
+        missing = [entry["timesteps"] for entry in evaluations if "env_steps" not in entry]
+        if missing:
+            raise ValueError(
+                f"evaluations at {missing} record no env_steps (trained before they were "
+                f"logged); retrain to compare learning speed"
+            )
+        points = []
+        for entry in evaluations:
+            learned, paper = entry["learned"], entry["paper"]
+            points.append(
+                {
+                    "timesteps": entry["timesteps"],
+                    "env_steps": entry["env_steps"],
+                    "wall_time_s": entry["wall_time_s"],
+                    "cost_ratio": learned["mean_cost"] / paper["mean_cost"],
+                    "transmission_ratio": learned["transmissions"] / paper["transmissions"],
+                    "failures": learned["failures"],
+                }
+            )
+        if not points:
+            raise ValueError("no validation recorded yet")
+        paper_failures = evaluations[0]["paper"]["failures"]
     reached = next(
         (
             point
@@ -269,7 +293,9 @@ def learning_curves(
             )
         methods.update(result["methods"])
     for label, folder in runs:
-        methods.setdefault(label, {"runs": []})["runs"].append(run_curve(folder, cost_tolerance))
+        with in_file(f"--run {label}={folder}"):
+            curve = run_curve(folder, cost_tolerance)
+        methods.setdefault(label, {"runs": []})["runs"].append(curve)
     for method in methods.values():
         method["bands"] = seed_bands(method["runs"])
         reached = [run for run in method["runs"] if run["reached_at_env_steps"] is not None]

@@ -155,15 +155,17 @@ MAX_SIGMA = 2.0 * LOG2_FACTOR_RANGE
 MAX_SEED = 2**31 - 1
 
 
-def read_config(path: str | Path) -> dict[str, Any]:
-    """The mapping of keys in the YAML file ``path`` (``ValueError`` naming ``--config``)."""
+def read_config(path: str | Path, where: str | None = None) -> dict[str, Any]:
+    """The mapping of keys in the YAML file ``path`` (``ValueError`` starting with ``where``,
+    default ``--config PATH``)."""
+    where = where or f"--config {path}"
     try:
         raw = yaml.safe_load(Path(path).read_text())
     except (OSError, UnicodeDecodeError, yaml.YAMLError, RecursionError) as error:
         reason = getattr(error, "strerror", None) or str(error).splitlines()[0]
-        raise ValueError(f"--config {path}: not a readable YAML file ({reason})") from None
+        raise ValueError(f"{where}: not a readable YAML file ({reason})") from None
     if not isinstance(raw, dict):
-        raise ValueError(f"--config {path}: a search config is a mapping of keys")
+        raise ValueError(f"{where}: a search config is a mapping of keys")
     return raw
 
 
