@@ -352,7 +352,7 @@ BOARDS = (
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/AttitudeTracking-v0",
-                "attitude_tracking_self_triggered_dqn",
+                "attitude_tracking_self_triggered_dqn_front",
                 "300",
                 "from scratch, 5 seeds at "
                 "λ = 300, best-validation checkpoints (no λ of 100, 300 contained the paper rule "
