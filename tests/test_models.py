@@ -52,6 +52,14 @@ SHIPPED_FROM_FRONTS = {
         "ClusterContainmentCentral-v0_ppo/transmission_penalty=10",
         2,
     ),
+    "ClusterContainment-v0_self_triggered": (
+        "ClusterContainment-v0_self_triggered_scratch/transmission_penalty=10",
+        1,
+    ),
+    "ClusterContainmentCentral-v0_self_triggered": (
+        "ClusterContainmentCentral-v0_self_triggered_tuned/transmission_penalty=10",
+        0,
+    ),
     "ClusterContainment-v0_self_triggered_dqn": (
         "ClusterContainment-v0_self_triggered_dqn/transmission_penalty=10",
         0,

@@ -194,14 +194,16 @@ def self_triggered_dqn(
 
 
 def self_triggered_tuned(
-    env_id: str, problem: str, penalty: str, decisions: str, choice: str
+    env_id: str, problem: str, penalty: str, decisions: str, choice: str, learner: str = "PPO"
 ) -> LearnerRecord:
-    """An id's self-triggered PPO row at hyperparameters tuned on validation: the front
-    ``configs/sweeps/<problem>_self_triggered_front.yaml`` chose ``penalty``, and the five seeds
-    of ``<problem>_self_triggered.yaml`` at the tuned values are judged into
-    ``<id>_self_triggered_tuned/``; ``decisions`` says what the policy chooses from, ``choice``
-    (after "5 seeds at λ = <penalty>") how the penalty and checkpoints were chosen."""
-    record = f"{env_id.removeprefix('etsc/')}_self_triggered_tuned"
+    """An id's self-triggered ``learner`` row (``PPO`` or ``DQN``) at hyperparameters tuned on
+    validation: the front ``configs/sweeps/<problem>_<stem>_front.yaml`` chose ``penalty``, and
+    the five seeds of ``<problem>_<stem>.yaml`` at the tuned values are judged into
+    ``<id>_<stem>_tuned/`` (``stem``: ``self_triggered``, ``self_triggered_dqn``); ``decisions``
+    says what the policy chooses from, ``choice`` (after "5 seeds at λ = <penalty>") how the
+    penalty and checkpoints were chosen."""
+    stem = "self_triggered" if learner == "PPO" else f"self_triggered_{learner.lower()}"
+    record = f"{env_id.removeprefix('etsc/')}_{stem}_tuned"
     return LearnerRecord(
         f"{record}/transmission_penalty={penalty}",
         f"{decisions}, hyperparameters tuned on validation (6 Optuna trials × 2 seeds at "
@@ -209,9 +211,9 @@ def self_triggered_tuned(
         f"λ = {penalty}{choice}",
         learner_front(
             env_id,
-            f"{problem}_self_triggered_front",
+            f"{problem}_{stem}_front",
             record,
-            judged_sweep=f"{problem}_self_triggered",
+            judged_sweep=f"{problem}_{stem}",
         ),
     )
 
@@ -302,18 +304,14 @@ BOARDS = (
                 "hyperparameters tuned on validation (6 Optuna trials × 2 seeds × 3 M steps at "
                 "λ = 10; the best trial's two runs are seeds 0 and 1)",
             ),
-            "self-triggered PPO": LearnerRecord(
-                "ClusterContainmentCentral-v0_self_triggered_scratch/transmission_penalty=10",
-                "holds after every follower transmits or eq. (15) × c, from scratch, 5 seeds at "
-                "λ = 10 per follower update (20 000 decisions of 1200-s episodes each), "
+            "self-triggered PPO": self_triggered_tuned(
+                "etsc/ClusterContainmentCentral-v0",
+                "cluster_central",
+                "10",
+                "holds after every follower transmits or eq. (15) × c from scratch",
+                " per follower update (20 000 decisions of 1200-s episodes each), "
                 "best-validation checkpoints (no λ of 1, 10 contained the paper rule on "
-                "validation; 10 came closest)",
-                learner_front(
-                    "etsc/ClusterContainmentCentral-v0",
-                    "cluster_central_self_triggered_front",
-                    "ClusterContainmentCentral-v0_self_triggered_scratch",
-                    judged_sweep="cluster_central_self_triggered",
-                ),
+                "validation at the values before tuning; 10 came closest)",
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/ClusterContainmentCentral-v0",
