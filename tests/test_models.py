@@ -35,8 +35,8 @@ SHIPPED_FROM_FRONTS = {
         0,
     ),
     "AttitudeTracking-v0_self_triggered_dqn": (
-        "AttitudeTracking-v0_self_triggered_dqn/transmission_penalty=300",
-        0,
+        "AttitudeTracking-v0_self_triggered_dqn_tuned/transmission_penalty=300",
+        2,
     ),
     "AsteroidOrbitKeeping-v0_ppo": ("AsteroidOrbitKeeping-v0_ppo/transmission_penalty=1", 3),
     "AsteroidOrbitKeeping-v0_self_triggered": (
