@@ -385,7 +385,7 @@ BOARDS = (
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/AsteroidOrbitKeeping-v0",
-                "asteroid_self_triggered_dqn",
+                "asteroid_self_triggered_dqn_front",
                 "0.3",
                 "unmasked (the shield replaces "
                 "an unsafe hold), 5 seeds at the PPO front's λ = 0.3, best-validation "
