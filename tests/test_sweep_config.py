@@ -269,11 +269,24 @@ def swept_penalties(grid: dict) -> list | None:
     return next((grid[key] for key in PENALTY_KEYS if key in grid), None)
 
 
+def hyperparameter_overrides(overrides: dict) -> list:
+    """The learner's values a sweep sets over its base config, whether as one
+    ``hyperparameters`` mapping or as dotted ``hyperparameters.KEY`` keys."""
+    values = dict(overrides.get("hyperparameters", {}))
+    values.update(
+        (key.removeprefix("hyperparameters."), value)
+        for key, value in overrides.items()
+        if key.startswith("hyperparameters.")
+    )
+    return sorted(values.items())
+
+
 def test_the_shipped_fronts_are_of_the_suites_ids() -> None:
     """Each shipped front trains or searches an id of the suite (one front per id, method and
-    penalty set at most: no two shipped fronts share a base config, algorithm and swept
-    penalties; a chosen configuration's ten search seeds, or a training front's chosen
-    penalty trained again, sit beside the front that chose the penalty)."""
+    penalty set at most: no two shipped fronts share a base config, algorithm, hyperparameters
+    and swept penalties; a chosen configuration's ten search seeds, a training front's chosen
+    penalty trained again, or its seeds at hyperparameters tuned since, sit beside the front
+    that chose the penalty)."""
     import etsc_envs
 
     every_id = set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
@@ -281,7 +294,12 @@ def test_the_shipped_fronts_are_of_the_suites_ids() -> None:
     assert configs and {config.base["env_id"] for config in configs} <= every_id
     raws = [yaml.safe_load(path.read_text()) for path in SHIPPED_FRONTS]
     methods = [
-        (raw["base"], raw.get("overrides", {}).get("algorithm"), str(swept_penalties(raw["grid"])))
+        (
+            raw["base"],
+            raw.get("overrides", {}).get("algorithm"),
+            str(swept_penalties(raw["grid"])),
+            str(hyperparameter_overrides(raw.get("overrides", {}))),
+        )
         for raw in raws
     ]
     assert len(set(methods)) == len(methods)
