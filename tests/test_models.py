@@ -44,8 +44,8 @@ SHIPPED_FROM_FRONTS = {
         0,
     ),
     "AsteroidOrbitKeeping-v0_self_triggered_dqn": (
-        "AsteroidOrbitKeeping-v0_self_triggered_dqn/transmission_penalty=0.3",
-        2,
+        "AsteroidOrbitKeeping-v0_self_triggered_dqn_tuned/transmission_penalty=0.3",
+        3,
     ),
     "ClusterContainment-v0_ppo": ("ClusterContainment-v0_ppo/transmission_penalty=10", 1),
     "ClusterContainmentCentral-v0_ppo": (

@@ -383,15 +383,14 @@ BOARDS = (
                 " (chosen on validation from 0.3, 1, 3, 10 at the values before tuning), "
                 "best-validation checkpoints",
             ),
-            "self-triggered DQN": self_triggered_dqn(
+            "self-triggered DQN": self_triggered_tuned(
                 "etsc/AsteroidOrbitKeeping-v0",
-                "asteroid_self_triggered_dqn_front",
+                "asteroid",
                 "0.3",
-                "unmasked (the shield replaces "
-                "an unsafe hold), 5 seeds at the PPO front's λ = 0.3, best-validation "
-                "checkpoints (λ does not contain the paper rule on validation: every seed "
-                "leaves the region or collides on most scenarios)",
-                processes=1,
+                "DQN (semi-Markov target) on the same decisions from scratch, the shield "
+                "replacing an unsafe hold",
+                " (the PPO front's choice), best-validation checkpoints",
+                learner="DQN",
             ),
         },
     ),
