@@ -46,7 +46,7 @@ import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import matplotlib
 
@@ -194,7 +194,12 @@ def self_triggered_dqn(
 
 
 def self_triggered_tuned(
-    env_id: str, problem: str, penalty: str, decisions: str, choice: str, learner: str = "PPO"
+    env_id: str,
+    problem: str,
+    penalty: str,
+    decisions: str,
+    choice: str,
+    learner: Literal["PPO", "DQN"] = "PPO",
 ) -> LearnerRecord:
     """An id's self-triggered ``learner`` row (``PPO`` or ``DQN``) at hyperparameters tuned on
     validation: the front ``configs/sweeps/<problem>_<stem>_front.yaml`` chose ``penalty``, and
