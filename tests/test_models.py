@@ -70,8 +70,8 @@ SHIPPED_FROM_FRONTS = {
     ),
     "OrbitAttitudeTracking-v0_ppo": ("OrbitAttitudeTracking-v0_ppo/transmission_penalty=1", 3),
     "OrbitAttitudeTracking-v0_self_triggered": (
-        "OrbitAttitudeTracking-v0_self_triggered_scratch/transmission_penalty=1",
-        2,
+        "OrbitAttitudeTracking-v0_self_triggered_tuned/transmission_penalty=1",
+        0,
     ),
     "OrbitAttitudeTracking-v0_self_triggered_dqn": (
         "OrbitAttitudeTracking-v0_self_triggered_dqn/transmission_penalty=1",

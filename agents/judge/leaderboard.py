@@ -241,17 +241,14 @@ BOARDS = (
                     "OrbitAttitudeTracking-v0_ppo",
                 ),
             ),
-            "self-triggered PPO": LearnerRecord(
-                "OrbitAttitudeTracking-v0_self_triggered_scratch/transmission_penalty=1",
-                "holds or eq. (21) × γ gating a 64-instant clock, from scratch, 5 seeds at "
-                "λ = 1 (100 000 decisions, 6.8 M instants of 60-s episodes each), "
-                "best-validation checkpoints (λ = 1 does not contain the paper rule on "
+            "self-triggered PPO": self_triggered_tuned(
+                "etsc/OrbitAttitudeTracking-v0",
+                "orbit_attitude",
+                "1",
+                "holds or eq. (21) × γ gating a 64-instant clock, from scratch",
+                " (100 000 decisions of 60-s episodes each), best-validation checkpoints "
+                "(λ = 1, the front's only penalty, does not contain the paper rule on "
                 "validation)",
-                learner_front(
-                    "etsc/OrbitAttitudeTracking-v0",
-                    "orbit_attitude_self_triggered_front",
-                    "OrbitAttitudeTracking-v0_self_triggered_scratch",
-                ),
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/OrbitAttitudeTracking-v0",
@@ -289,7 +286,7 @@ BOARDS = (
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/ClusterContainment-v0",
-                "cluster_shared_self_triggered_dqn",
+                "cluster_shared_self_triggered_dqn_front",
                 "10",
                 "one Q-network shared by the "
                 "followers, from scratch, 5 seeds at λ = 10 per follower update (12 288 "
@@ -320,7 +317,7 @@ BOARDS = (
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/ClusterContainmentCentral-v0",
-                "cluster_central_self_triggered_dqn",
+                "cluster_central_self_triggered_dqn_front",
                 "1",
                 "from scratch, 5 seeds at λ = 1 "
                 "per follower update (20 000 decisions of 1200-s episodes each), "
