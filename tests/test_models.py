@@ -65,7 +65,7 @@ SHIPPED_FROM_FRONTS = {
         0,
     ),
     "ClusterContainmentCentral-v0_self_triggered_dqn": (
-        "ClusterContainmentCentral-v0_self_triggered_dqn/transmission_penalty=1",
+        "ClusterContainmentCentral-v0_self_triggered_dqn_tuned/transmission_penalty=1",
         4,
     ),
     "OrbitAttitudeTracking-v0_ppo": ("OrbitAttitudeTracking-v0_ppo/transmission_penalty=1", 3),
