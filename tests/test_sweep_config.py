@@ -281,15 +281,15 @@ def test_the_shipped_fronts_are_of_the_suites_ids() -> None:
     every_id = set(etsc_envs.ENV_IDS) | set(etsc_envs.PETTINGZOO_ENV_IDS)
     configs = [load_sweep_config(path) for path in SHIPPED_FRONTS]
     assert configs and {config.base["env_id"] for config in configs} <= every_id
-    raws = [yaml.safe_load(path.read_text()) for path in SHIPPED_FRONTS]
+    bases = [yaml.safe_load(path.read_text())["base"] for path in SHIPPED_FRONTS]
     methods = [
         (
-            raw["base"],
-            raw.get("overrides", {}).get("algorithm"),
-            str(swept_penalties(raw["grid"])),
+            base,
+            config.base.get("algorithm"),
+            str(swept_penalties(config.grid)),
             json.dumps(config.base.get("hyperparameters"), sort_keys=True),
         )
-        for raw, config in zip(raws, configs, strict=True)
+        for base, config in zip(bases, configs, strict=True)
     ]
     assert len(set(methods)) == len(methods)
 
