@@ -252,7 +252,7 @@ BOARDS = (
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/OrbitAttitudeTracking-v0",
-                "orbit_attitude_self_triggered_dqn",
+                "orbit_attitude_self_triggered_dqn_front",
                 "1",
                 "from scratch, 5 seeds at "
                 "λ = 1 (100 000 decisions of 60-s episodes each), best-validation checkpoints "
