@@ -427,7 +427,7 @@ BOARDS = (
             ),
             "self-triggered DQN": self_triggered_dqn(
                 "etsc/InnerFormation-v0",
-                "inner_formation_self_triggered_dqn",
+                "inner_formation_self_triggered_dqn_front",
                 "5",
                 "unmasked (the shield replaces an unsafe hold), from scratch, 5 seeds at λ = 5 "
                 "(200 000 decisions of 20-s episodes each), best-validation checkpoints (λ = 5 "
