@@ -136,6 +136,25 @@ def test_a_training_front_is_judged_at_its_best_validation_checkpoints(tmp_path:
     assert choice["penalties"][1]["larger_ratio"] == pytest.approx(1.15)
 
 
+def test_a_run_is_judged_at_its_best_trained_checkpoint_not_an_untrained_one(
+    tmp_path: Path,
+) -> None:
+    """An evaluation of a network no gradient step had touched (``"trained": false``) is not
+    the checkpoint a run keeps, however well it scored; a run that validated no trained
+    policy is refused in one line."""
+    runs = {(100.0, 0): [(-1.0, 10.0, 0.009), (-7.0, 140.0, 0.0099)]}
+    front = _training_front(tmp_path / "front", runs)
+    record = front / "trials" / "transmission_penalty=100,seed=0" / "evaluations.json"
+    entries = json.loads(record.read_text())
+    entries[0]["trained"] = False
+    record.write_text(json.dumps(entries))
+    assert choose_penalty(front)["penalties"][0]["learned"]["transmissions"] == 140.0
+    entries[1]["trained"] = False
+    record.write_text(json.dumps(entries))
+    with pytest.raises(ValueError, match="validated no trained policy"):
+        choose_penalty(front)
+
+
 def test_where_no_penalty_contains_the_closest_is_named(tmp_path: Path, capsys) -> None:
     front = _training_front(
         tmp_path,

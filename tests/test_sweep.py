@@ -24,6 +24,7 @@ pytest.importorskip(
 )
 
 from agents.sweep.runner import main
+from agents.train.kept_checkpoint import kept_evaluation
 from tests.child_process import interruptible
 from tests.sweep_fixtures import retrained_differences, tiny_sweep
 
@@ -251,7 +252,9 @@ def test_a_search_trial_of_several_seeds_reports_their_mean(tmp_path: Path) -> N
         assert (run / "model.zip").is_file()
         assert yaml.safe_load((run / "config.yaml").read_text())["seed"] == seed
         evaluations = json.loads((run / "evaluations.json").read_text(encoding="utf-8"))
-        returns.append(max(entry["learned"]["return"] for entry in evaluations))
+        kept = kept_evaluation(evaluations)
+        assert kept is not None and kept["trained"]
+        returns.append(kept["learned"]["return"])
     assert returns[0] != returns[1], "the seeds train differently"
     assert trial["scores"]["best_validation_return"] == pytest.approx(sum(returns) / 2)
 

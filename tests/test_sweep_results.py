@@ -61,6 +61,18 @@ def test_the_best_validation_return_is_the_kept_checkpoints_not_the_last() -> No
     assert scores(1024, None, history[:1])["best_validation_return"] == -9.0
 
 
+def test_an_untrained_policys_validation_is_not_the_score_of_the_kept_checkpoint() -> None:
+    """A tuning scores a run by the checkpoint it keeps, which is never a policy no gradient
+    step had touched (``"trained": false``, e.g. DQN before ``learning_starts``); before the
+    first trained validation there is no such score."""
+    untrained = evaluation(1.0, 30, 1.0, 120, learned_return=-1.0) | {"trained": False}
+    trained = [
+        evaluation(1.0, 30, 1.0, 120, learned_return=r) | {"trained": True} for r in (-6.0, -4.0)
+    ]
+    assert scores(4096, None, [untrained, *trained])["best_validation_return"] == -4.0
+    assert "best_validation_return" not in scores(4096, None, [untrained])
+
+
 def test_a_trial_of_several_seeds_scores_their_mean_once_all_finished(tmp_path: Path) -> None:
     runs = [tmp_path / "seed=0", tmp_path / "seed=1"]
     for run, best in zip(runs, (-4.0, -2.0), strict=True):

@@ -295,3 +295,63 @@ def test_config_rejects_bad_training_options(tmp_path: Path, key, value, message
     config = tiny_config(tmp_path) | {key: value}
     with pytest.raises(ValueError, match=message):
         config_from_dict(config)
+
+
+def test_a_network_not_yet_trained_is_validated_but_never_kept(tmp_path: Path) -> None:
+    """DQN updates its network only after ``learning_starts`` steps: validations before then
+    record the untrained network (``"trained": false``, 0 updates) on the learning curve, and
+    the checkpoint the run keeps is always a trained one."""
+    import zipfile
+
+    from agents.train.training import BEST_MODEL_FILE
+
+    out_dir = tmp_path / "run"
+    config = tiny_config(out_dir, CONFIG_DIR / "attitude_tracking_self_triggered.yaml")
+    config.update(
+        algorithm="DQN",
+        hyperparameters={"learning_starts": 64, "batch_size": 16, "train_freq": 1, "device": "cpu"},
+        total_timesteps=128,
+        evaluation_every=32,
+        evaluation_scenarios=1,
+    )
+    assert main(["--config", str(write_config(config, tmp_path))]) == 0
+    evaluations = json.loads((out_dir / "evaluations.json").read_text(encoding="utf-8"))
+    assert [entry["timesteps"] for entry in evaluations] == [32, 64, 96, 128]
+    assert [entry["trained"] for entry in evaluations] == [False, False, True, True]
+    assert [entry["updates"] > 0 for entry in evaluations] == [False, False, True, True]
+    with zipfile.ZipFile(out_dir / BEST_MODEL_FILE) as saved:
+        assert json.loads(saved.read("data"))["_n_updates"] > 0
+
+
+def test_an_untrained_policy_that_validates_best_is_not_kept(tmp_path: Path) -> None:
+    """However well a policy no gradient step has touched scores, the kept checkpoint is the
+    best trained one; a run started from a trained model (``init_from``) may keep its start."""
+    from types import SimpleNamespace
+
+    from agents.train.validation_callback import PaperComparisonCallback
+
+    def validated(returns: list[tuple[int, float]], starts_trained: bool) -> list[float]:
+        callback = PaperComparisonCallback(
+            "etsc/AttitudeTracking-v0",
+            {},
+            every=10**9,
+            out_path=tmp_path / "evaluations.json",
+            set_size=1,
+            best_model_path=tmp_path / "best_model.zip",
+            starts_trained=starts_trained,
+        )
+        kept: list[float] = []
+        logger = SimpleNamespace(record=lambda *args, **kwargs: None)
+        callback.paper = {"mean_cost": 1.0, "transmissions": 1}
+        callback._current_policy = lambda: None
+        callback._save_best = lambda: kept.append(callback.best_return)
+        for updates, value in returns:
+            callback.model = SimpleNamespace(_n_updates=updates, logger=logger)
+            record = {"mean_cost": 1.0, "transmissions": 1, "transmission_rate": 0.1}
+            record |= {"return": value, "failure": None}
+            callback._run = lambda policy, record=record: [record]
+            callback._evaluate()
+        return kept
+
+    assert validated([(0, -1.0), (8, -5.0), (16, -3.0)], starts_trained=False) == [-5.0, -3.0]
+    assert validated([(0, -1.0), (8, -5.0), (16, -3.0)], starts_trained=True) == [-1.0]

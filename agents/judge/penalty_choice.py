@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from agents.sweep.results import EVALUATIONS_FILE, SEARCH_CURVE_FILE, read_sweep
+from agents.train.kept_checkpoint import kept_evaluation
 from etsc_envs.core.files import output_file_argument
 from etsc_envs.evaluation.arguments import write_json
 
@@ -69,8 +70,9 @@ def validation_points(folder: Path) -> tuple[Point, Point]:
 
 
 def training_points(folder: Path) -> tuple[Point, Point]:
-    """A training run's paper rule and its evaluation of the best validation return (the
-    first of equal ones, as the callback keeps it), from its ``evaluations.json``."""
+    """A training run's paper rule and the evaluation of the checkpoint it keeps (the best
+    validation return of a trained policy, the first of equal ones:
+    :func:`~agents.train.kept_checkpoint.kept_evaluation`), from its ``evaluations.json``."""
     path = folder / EVALUATIONS_FILE
     if not path.is_file():
         raise ValueError(
@@ -80,7 +82,9 @@ def training_points(folder: Path) -> tuple[Point, Point]:
     evaluations = json.loads(path.read_text(encoding="utf-8"))
     if not evaluations:
         raise ValueError(f"RESULTS_DIR: trial {folder.name!r} has no evaluation")
-    best = max(evaluations, key=lambda entry: entry["learned"]["return"])
+    best = kept_evaluation(evaluations)
+    if best is None:
+        raise ValueError(f"RESULTS_DIR: trial {folder.name!r} validated no trained policy")
 
     def point(summary: dict[str, Any]) -> Point:
         return float(summary["transmissions"]), float(summary["mean_cost"])

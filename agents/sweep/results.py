@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from agents.train.kept_checkpoint import kept_evaluation
 from etsc_envs.core.files import atomic_write_text
 
 SUMMARY_FILE = "sweep_summary.json"
@@ -56,8 +57,9 @@ METRICS = (
 evaluated): training steps, the mean return of the last training episodes, the last
 evaluation's ``mean_cost`` and transmissions of the learned policy and of the paper trigger,
 their ratios learned / paper (absent where the paper's value is 0), and the highest mean
-validation return of the evaluations so far — the score of the checkpoint the run keeps
-(``best_model.zip``), which a hyperparameter search maximises."""
+validation return of the trained policies' evaluations so far
+(:func:`agents.train.kept_checkpoint.kept_evaluation`) — the score of the checkpoint the run
+keeps (``best_model.zip``), which a hyperparameter search maximises."""
 
 EVALUATION_METRICS = METRICS[2:]
 """The metrics that come from the training run's evaluations against the paper trigger."""
@@ -81,9 +83,9 @@ def scores(
     for ratio, key in (("cost_ratio", "mean_cost"), ("transmission_ratio", "transmissions")):
         if paper[key]:
             result[ratio] = learned[key] / paper[key]
-    result["best_validation_return"] = max(
-        float(evaluation["learned"]["return"]) for evaluation in evaluations
-    )
+    kept = kept_evaluation(evaluations)
+    if kept is not None:
+        result["best_validation_return"] = float(kept["learned"]["return"])
     return result
 
 

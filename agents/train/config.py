@@ -32,8 +32,8 @@ A config is a YAML mapping with these keys (the optional ones show their default
   ``out_dir/checkpoints``, from which ``--resume`` continues; 0 saves no checkpoints;
 * ``evaluation_every: 0`` — every that many steps, run the current policy on the protocol's
   validation scenarios (the paper's trigger once, at the start) and log both (TensorBoard and
-  ``out_dir/evaluations.json``), keeping the best model by mean validation return in
-  ``out_dir/best_model.zip``; 0 never evaluates;
+  ``out_dir/evaluations.json``), keeping the best trained model by mean validation return in
+  ``out_dir/best_model.zip`` (:mod:`agents.train.kept_checkpoint`); 0 never evaluates;
 * ``evaluation_scenarios: 16`` — validation scenarios per evaluation (the first of the set);
 * ``evaluation_env_kwargs: {}`` — env kwargs of that evaluation on top of the training ones
   (the set's ``randomize`` replaces theirs), e.g. a shorter ``horizon_s``;

@@ -550,7 +550,7 @@ def _periodic_callbacks(
             config.evaluation_scenarios,
             out_dir / BEST_MODEL_FILE,
             decisions,
-            evaluate_at_start=config.init_from is not None,
+            starts_trained=config.init_from is not None,
         )
         if checkpoint is not None:
             evaluation.restore(_previous_evaluations(out_dir, checkpoint))

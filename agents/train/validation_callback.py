@@ -2,8 +2,8 @@
 
 Model selection follows the test protocol (``docs/protocol.md``): the training run is scored
 on the *validation* set only (the test set is for reporting), all its scenarios at once in the
-native vector env (:func:`etsc_envs.evaluation.batch.run_batch`), and the best-scoring model is
-kept.
+native vector env (:func:`etsc_envs.evaluation.batch.run_batch`), and the best-scoring trained
+model is kept (:mod:`agents.train.kept_checkpoint`).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
+from agents.train.kept_checkpoint import TRAINED_KEY, kept_evaluation
 from agents.train.model_files import write_model
 from etsc_envs.core.files import atomic_write_text
 from etsc_envs.decisions import DecisionSet, SelfTriggeredPolicy
@@ -65,21 +66,24 @@ class PaperComparisonCallback(BaseCallback):
         env_kwargs: kwargs of the evaluation envs (the set's ``randomize`` replaces theirs).
         every: training steps between evaluations.
         out_path: JSON file that receives the list of evaluations after each one (each entry
-            ``{"timesteps", "env_steps", "wall_time_s", "learned": {...}, "paper": {...}}`` with
-            :func:`set_summary`'s keys; ``env_steps`` counts the sampling instants simulated
-            for training so far — ``timesteps`` times the env's ``decision_interval`` (1 but
-            on 003, whose per-instant env may decide every few sampling periods), the sum of
-            the decisions' ``info["elapsed_steps"]`` for self-triggered decisions — and
-            ``wall_time_s`` the training time since the start, evaluations included).
+            ``{"timesteps", "env_steps", "wall_time_s", "updates", "trained", "learned": {...},
+            "paper": {...}}`` with :func:`set_summary`'s keys; ``env_steps`` counts the
+            sampling instants simulated for training so far — ``timesteps`` times the env's
+            ``decision_interval`` (1 but on 003, whose per-instant env may decide every few
+            sampling periods), the sum of the decisions' ``info["elapsed_steps"]`` for
+            self-triggered decisions — ``wall_time_s`` the training time since the start,
+            evaluations included, ``updates`` the model's gradient updates so far and
+            ``trained`` whether the evaluated policy had been trained).
         set_size: validation scenarios per evaluation.
-        best_model_path: where the model with the highest mean validation return so far is
-            saved (with its observation statistics beside it), or ``None``.
+        best_model_path: where the trained model with the highest mean validation return so
+            far is saved (with its observation statistics beside it), or ``None``; a policy
+            not yet trained is validated but never kept (:mod:`agents.train.kept_checkpoint`).
         decisions: the decision set of a model trained on self-triggered decisions (it is
             evaluated as :class:`~etsc_envs.decisions.SelfTriggeredPolicy` and saved with
             the set beside it), or ``None``.
-        evaluate_at_start: also evaluate the policy training starts from (timesteps 0), so
-            that a run started from an earlier model (``init_from``) can keep it as its best model
-            when reinforcement only makes it worse.
+        starts_trained: the run starts from an earlier, trained model (``init_from``): the
+            policy it starts from is evaluated too (timesteps 0) and counts as trained, so that
+            the run can keep it as its best model when reinforcement only makes it worse.
 
     Logged (TensorBoard and SB3's logger): ``eval/mean_cost``, ``eval/transmissions``,
     ``eval/return`` and the paper trigger's ``eval/paper_mean_cost``,
@@ -95,10 +99,10 @@ class PaperComparisonCallback(BaseCallback):
         set_size: int,
         best_model_path: str | Path | None = None,
         decisions: DecisionSet | None = None,
-        evaluate_at_start: bool = False,
+        starts_trained: bool = False,
     ) -> None:
         super().__init__()
-        self.evaluate_at_start = evaluate_at_start
+        self.starts_trained = starts_trained
         self.env_id = env_id
         self.scenarios = scenario_set("validation", set_size)
         base = {key: value for key, value in env_kwargs.items() if key != "randomize"}
@@ -126,7 +130,7 @@ class PaperComparisonCallback(BaseCallback):
         self.paper = set_summary(self._run(paper_trigger))
         self._next_evaluation = self.num_timesteps + self.every
         self._started = time.perf_counter()
-        if self.evaluate_at_start and not self.evaluations:
+        if self.starts_trained and not self.evaluations:
             self._evaluate()
 
     def _on_step(self) -> bool:
@@ -141,13 +145,18 @@ class PaperComparisonCallback(BaseCallback):
         return True
 
     def _evaluate(self) -> None:
-        """Run the current policy on the validation scenarios; record, log, keep the best."""
+        """Run the current policy on the validation scenarios; record, log, keep the best
+        trained one."""
         learned = set_summary(self._run(self._current_policy()))
+        updates = int(self.model._n_updates)
+        trained = self.starts_trained or updates > 0
         self.evaluations.append(
             {
                 "timesteps": self.num_timesteps,
                 "env_steps": self.env_steps,
                 "wall_time_s": self._earlier_wall_time_s + time.perf_counter() - self._started,
+                "updates": updates,
+                TRAINED_KEY: trained,
                 "scenarios": self.scenarios.describe(),
                 "learned": learned,
                 "paper": self.paper,
@@ -157,20 +166,20 @@ class PaperComparisonCallback(BaseCallback):
             self.logger.record(f"eval/{name}mean_cost", summary["mean_cost"])
             self.logger.record(f"eval/{name}transmissions", summary["transmissions"])
         self.logger.record("eval/return", learned["return"])
-        if self.best_model_path is not None and learned["return"] > self.best_return:
+        if self.best_model_path is not None and trained and learned["return"] > self.best_return:
             self.best_return = learned["return"]
             self._save_best()
         atomic_write_text(self.out_path, json.dumps(to_jsonable(self.evaluations), indent=2) + "\n")
 
     def restore(self, history: list[dict[str, Any]]) -> None:
         """Continue an interrupted run: keep its evaluations (up to the resumed checkpoint)
-        and its best validation return so far."""
+        and the validation return of its kept checkpoint so far."""
         self.evaluations = list(history)
         if history:
             self.env_steps = int(history[-1].get("env_steps", history[-1]["timesteps"]))
             self._earlier_wall_time_s = float(history[-1].get("wall_time_s", 0.0))
-        returns = [entry["learned"].get("return") for entry in history if "learned" in entry]
-        self.best_return = max((r for r in returns if r is not None), default=-np.inf)
+        kept = kept_evaluation(history)
+        self.best_return = -np.inf if kept is None else float(kept["learned"]["return"])
 
     def _run(self, policy: Any) -> list[dict[str, Any]]:
         return run_batch(self.env_id, policy, self.scenarios.seeds, self.env_kwargs)
