@@ -274,6 +274,15 @@ def test_resume_without_checkpoints_is_a_clear_error(tmp_path: Path) -> None:
         main(["--config", str(config_path), "--resume"])
 
 
+def test_config_rejects_a_learner_that_would_never_train(tmp_path: Path) -> None:
+    config = tiny_config(tmp_path, CONFIG_DIR / "attitude_tracking_self_triggered.yaml")
+    config.update(algorithm="DQN", hyperparameters={"learning_starts": 256})
+    with pytest.raises(ValueError, match=r"'hyperparameters.learning_starts' must be below total"):
+        config_from_dict(config)
+    config["hyperparameters"]["learning_starts"] = 255
+    assert config_from_dict(config).total_timesteps == 256
+
+
 def test_config_rejects_dqn_for_a_multibinary_action(tmp_path: Path) -> None:
     config = tiny_config(tmp_path, CONFIG_DIR / "inner_formation_ppo.yaml")
     config.update(algorithm="DQN", hyperparameters={})

@@ -187,6 +187,8 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
     decisions = _check_decisions(values, algorithm, env_id, env_kwargs)
     _check_algorithm_fits_env(algorithm, env_id, env_kwargs, decisions)
+    total_timesteps = _check_positive_int("total_timesteps", values["total_timesteps"])
+    _check_learning_starts(values["hyperparameters"], total_timesteps)
     return TrainConfig(
         env_id=env_id,
         env_kwargs=env_kwargs,
@@ -195,7 +197,7 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         hyperparameters=_check_buffer_fits(
             _check_hyperparameters(values["hyperparameters"], algorithm), n_envs
         ),
-        total_timesteps=_check_positive_int("total_timesteps", values["total_timesteps"]),
+        total_timesteps=total_timesteps,
         n_envs=n_envs,
         seed=seed,
         out_dir=_check_out_dir(values["out_dir"]),
@@ -217,6 +219,18 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
         init_from=_check_init_from(values["init_from"], env_id, env_kwargs, decisions),
         decisions=decisions,
     )
+
+
+def _check_learning_starts(hyperparameters: Any, total_timesteps: int) -> None:
+    """``ValueError`` if an off-policy learner would start learning only after the run ends:
+    it would never update its network, and an untrained network is never kept
+    (:mod:`agents.train.kept_checkpoint`)."""
+    learning_starts = (hyperparameters or {}).get("learning_starts")
+    if isinstance(learning_starts, int) and learning_starts >= total_timesteps:
+        raise ValueError(
+            f"config key 'hyperparameters.learning_starts' must be below total_timesteps "
+            f"({total_timesteps}), got {learning_starts}: the run would never train"
+        )
 
 
 def require_key_set(
