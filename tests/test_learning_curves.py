@@ -45,6 +45,18 @@ def test_a_run_reaches_the_paper_trigger_when_as_accurate_on_no_more_transmissio
     assert decisions["wall_time_s_to_reach"] == {"median": 6.0, "range": [6.0, 6.0]}
 
 
+def test_an_untrained_network_does_not_reach_the_paper_trigger(tmp_path: Path) -> None:
+    """A validation of a network no gradient step had touched is drawn on the curve, but a run
+    reaches the paper trigger only with a trained policy."""
+    folder = _run(tmp_path / "dqn", [(1.0, 50.0, 0), (1.2, 80.0, 0), (1.0, 90.0, 0)], 1)
+    evaluations = json.loads((folder / "evaluations.json").read_text(encoding="utf-8"))
+    evaluations[0]["trained"] = False
+    (folder / "evaluations.json").write_text(json.dumps(evaluations), encoding="utf-8")
+    (run,) = learning_curves(parse_runs([f"dqn={folder}"]), 1.05)["methods"]["dqn"]["runs"]
+    assert [point["trained"] for point in run["points"]] == [False, True, True]
+    assert run["reached_at_env_steps"] == 30
+
+
 def test_seeds_of_a_method_are_summarised_together(tmp_path: Path) -> None:
     runs = [
         _run(tmp_path / f"seed{seed}", [(2.0, 50.0, 0)] * seed + [(1.0, 50.0, 0)], 1)

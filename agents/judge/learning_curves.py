@@ -18,9 +18,11 @@ are no longer at hand) beside the new runs. Runs with the
 same ``LABEL`` (one method, several training seeds) are drawn in one colour and summarised
 together.
 
-A run **reaches the paper trigger** at its first evaluation whose validation ``mean_cost`` is
-at most ``cost_tolerance`` times the paper trigger's and whose transmissions are at most the
-paper trigger's: as accurate (within the goal's tolerance) on no more transmissions. Cost alone
+A run **reaches the paper trigger** at its first evaluation of a trained policy
+(:mod:`agents.train.kept_checkpoint`; an untrained network is drawn but reaches nothing) whose
+validation ``mean_cost`` is at most ``cost_tolerance`` times the paper trigger's and whose
+transmissions are at most the paper trigger's: as accurate (within the goal's tolerance) on no
+more transmissions. Cost alone
 would be reached by a policy that transmits at every instant. The report gives, per run, the
 instants and seconds it took (``null`` if it never did) and, per label, the median and range
 over the runs that reached it.
@@ -50,6 +52,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
 
+from agents.train.kept_checkpoint import may_be_kept
 from baselines.plotting import save
 from etsc_envs.core.files import output_folder_argument, require_writable_folder
 from etsc_envs.core.json_files import in_file, read_json_file, read_json_lines, require_mapping
@@ -199,6 +202,7 @@ def run_curve(folder: Path, cost_tolerance: float) -> dict[str, Any]:
                     "cost_ratio": learned["mean_cost"] / paper["mean_cost"],
                     "transmission_ratio": learned["transmissions"] / paper["transmissions"],
                     "failures": learned["failures"],
+                    "trained": may_be_kept(entry),
                 }
             )
         if not points:
@@ -208,7 +212,8 @@ def run_curve(folder: Path, cost_tolerance: float) -> dict[str, Any]:
         (
             point
             for point in points
-            if point["cost_ratio"] <= cost_tolerance
+            if point["trained"]
+            and point["cost_ratio"] <= cost_tolerance
             and point["transmission_ratio"] <= 1.0
             and (point["failures"] is None or point["failures"] <= paper_failures)
         ),
