@@ -353,7 +353,7 @@ def test_an_untrained_policy_that_validates_best_is_not_kept(tmp_path: Path) -> 
         logger = SimpleNamespace(record=lambda *args, **kwargs: None)
         callback.paper = {"mean_cost": 1.0, "transmissions": 1}
         callback._current_policy = lambda: None
-        callback._save_best = lambda: kept.append(callback.best_return)
+        callback._save_best = lambda: kept.append(callback.evaluations[-1]["learned"]["return"])
         for updates, value in returns:
             callback.model = SimpleNamespace(_n_updates=updates, logger=logger)
             record = {"mean_cost": 1.0, "transmissions": 1, "transmission_rate": 0.1}

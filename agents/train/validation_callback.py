@@ -112,7 +112,6 @@ class PaperComparisonCallback(BaseCallback):
         self.best_model_path = None if best_model_path is None else Path(best_model_path)
         self.evaluations: list[dict[str, Any]] = []
         self.paper: dict[str, Any] = {}
-        self.best_return = -np.inf
         self._next_evaluation = every
         self.decisions = decisions
         self._deployment: tuple[Any, ...] | None = None
@@ -166,20 +165,20 @@ class PaperComparisonCallback(BaseCallback):
             self.logger.record(f"eval/{name}mean_cost", summary["mean_cost"])
             self.logger.record(f"eval/{name}transmissions", summary["transmissions"])
         self.logger.record("eval/return", learned["return"])
-        if self.best_model_path is not None and trained and learned["return"] > self.best_return:
-            self.best_return = learned["return"]
+        if (
+            self.best_model_path is not None
+            and kept_evaluation(self.evaluations) is self.evaluations[-1]
+        ):
             self._save_best()
         atomic_write_text(self.out_path, json.dumps(to_jsonable(self.evaluations), indent=2) + "\n")
 
     def restore(self, history: list[dict[str, Any]]) -> None:
-        """Continue an interrupted run: keep its evaluations (up to the resumed checkpoint)
-        and the validation return of its kept checkpoint so far."""
+        """Continue an interrupted run: keep its evaluations (up to the resumed checkpoint),
+        among them the kept checkpoint's so far."""
         self.evaluations = list(history)
         if history:
             self.env_steps = int(history[-1].get("env_steps", history[-1]["timesteps"]))
             self._earlier_wall_time_s = float(history[-1].get("wall_time_s", 0.0))
-        kept = kept_evaluation(history)
-        self.best_return = -np.inf if kept is None else float(kept["learned"]["return"])
 
     def _run(self, policy: Any) -> list[dict[str, Any]]:
         return run_batch(self.env_id, policy, self.scenarios.seeds, self.env_kwargs)
