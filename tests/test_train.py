@@ -281,6 +281,9 @@ def test_config_rejects_a_learner_that_would_never_train(tmp_path: Path) -> None
         config_from_dict(config)
     config["hyperparameters"]["learning_starts"] = 255
     assert config_from_dict(config).total_timesteps == 256
+    config["hyperparameters"] = [255]
+    with pytest.raises(ValueError, match="'hyperparameters' must be a mapping"):
+        config_from_dict(config)
 
 
 def test_config_rejects_dqn_for_a_multibinary_action(tmp_path: Path) -> None:

@@ -187,16 +187,17 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     env_kwargs = {**TRAINING_ENV_DEFAULTS, **_check_mapping("env_kwargs", values["env_kwargs"])}
     decisions = _check_decisions(values, algorithm, env_id, env_kwargs)
     _check_algorithm_fits_env(algorithm, env_id, env_kwargs, decisions)
+    hyperparameters = _check_buffer_fits(
+        _check_hyperparameters(values["hyperparameters"], algorithm), n_envs
+    )
     total_timesteps = _check_positive_int("total_timesteps", values["total_timesteps"])
-    _check_learning_starts(values["hyperparameters"], total_timesteps)
+    _check_learning_starts(hyperparameters, total_timesteps)
     return TrainConfig(
         env_id=env_id,
         env_kwargs=env_kwargs,
         algorithm=algorithm,
         policy=_check_policy(values["policy"], algorithm),
-        hyperparameters=_check_buffer_fits(
-            _check_hyperparameters(values["hyperparameters"], algorithm), n_envs
-        ),
+        hyperparameters=hyperparameters,
         total_timesteps=total_timesteps,
         n_envs=n_envs,
         seed=seed,
@@ -221,11 +222,11 @@ def config_from_dict(raw: Mapping[str, Any]) -> TrainConfig:
     )
 
 
-def _check_learning_starts(hyperparameters: Any, total_timesteps: int) -> None:
+def _check_learning_starts(hyperparameters: dict[str, Any], total_timesteps: int) -> None:
     """``ValueError`` if an off-policy learner would start learning only after the run ends:
     it would never update its network, and an untrained network is never kept
     (:mod:`agents.train.kept_checkpoint`)."""
-    learning_starts = (hyperparameters or {}).get("learning_starts")
+    learning_starts = hyperparameters.get("learning_starts")
     if isinstance(learning_starts, int) and learning_starts >= total_timesteps:
         raise ValueError(
             f"config key 'hyperparameters.learning_starts' must be below total_timesteps "
