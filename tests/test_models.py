@@ -54,8 +54,8 @@ SHIPPED_FROM_FRONTS = {
         2,
     ),
     "ClusterContainment-v0_self_triggered": (
-        "ClusterContainment-v0_self_triggered_scratch/transmission_penalty=10",
-        1,
+        "ClusterContainment-v0_self_triggered_tuned/transmission_penalty=10",
+        3,
     ),
     "ClusterContainmentCentral-v0_self_triggered": (
         "ClusterContainmentCentral-v0_self_triggered_tuned/transmission_penalty=10",

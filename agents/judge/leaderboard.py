@@ -272,18 +272,14 @@ BOARDS = (
                 "hyperparameters tuned on validation (6 Optuna trials × 2 seeds × 6 M agent "
                 "steps at λ = 10; rl-zoo3's defaults stayed best)",
             ),
-            "self-triggered PPO": LearnerRecord(
-                "ClusterContainment-v0_self_triggered_scratch/transmission_penalty=10",
-                "holds or eq. (15) × c, one policy shared by the followers, from scratch, "
-                "5 seeds at λ = 10 per follower update (12 288 follower decisions of 1200-s "
-                "episodes each), best-validation checkpoints (λ = 10 does not contain the "
-                "paper rule on validation: ×14 its updates; seeds 0 and 3 kept untrained "
-                "networks, which training no longer keeps)",
-                learner_front(
-                    "etsc/ClusterContainment-v0",
-                    "cluster_shared_self_triggered_front",
-                    "ClusterContainment-v0_self_triggered_scratch",
-                ),
+            "self-triggered PPO": self_triggered_tuned(
+                "etsc/ClusterContainment-v0",
+                "cluster_shared",
+                "10",
+                "holds or eq. (15) × c, one policy shared by the followers, from scratch",
+                " per follower update (12 288 follower decisions of 1200-s episodes each), "
+                "best-validation checkpoints of trained networks (λ = 10, the front's only "
+                "penalty, does not contain the paper rule on validation)",
             ),
             "self-triggered DQN": self_triggered_tuned(
                 "etsc/ClusterContainment-v0",
