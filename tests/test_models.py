@@ -75,8 +75,8 @@ SHIPPED_FROM_FRONTS = {
         0,
     ),
     "OrbitAttitudeTracking-v0_self_triggered_dqn": (
-        "OrbitAttitudeTracking-v0_self_triggered_dqn/transmission_penalty=1",
-        4,
+        "OrbitAttitudeTracking-v0_self_triggered_dqn_tuned/transmission_penalty=1",
+        2,
     ),
     "InnerFormation-v0_ppo": ("InnerFormation-v0_ppo/transmission_penalty=5", 1),
     "InnerFormation-v0_self_triggered": (
